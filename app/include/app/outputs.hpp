@@ -1,0 +1,32 @@
+// app/outputs.hpp — files a run leaves behind (docs/formats.md): metrics.json, levels.lbrs.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "app/batch.hpp"
+#include "app/profile.hpp"
+#include "nc/toolpath.hpp"
+
+namespace lbr::app {
+
+// Loads a tool path, choosing the front end by file extension (.moves; G-code: .ngc, .nc,
+// .gcode, .tap). `profile` supplies the tool table. Throws nc::ParseError or
+// std::runtime_error with file and line.
+[[nodiscard]] nc::Toolpath load_toolpath(const std::string& path, const Profile& profile);
+// The bundled demo part program (config/programs/demo-pocket.moves, compiled in).
+[[nodiscard]] nc::Toolpath demo_toolpath();
+
+// Metrics of a batch run as a JSON document (keys in docs/formats.md#metrics).
+[[nodiscard]] std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program);
+
+// Creates `dir` if needed and writes metrics.json and levels.lbrs into it. Throws
+// std::runtime_error naming the path on I/O failure.
+void write_batch_outputs(const std::string& dir, const BatchResult& r, const Profile& profile,
+                         const std::string& program);
+
+void write_file(const std::string& path, const std::string& bytes);
+void write_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
+
+}  // namespace lbr::app

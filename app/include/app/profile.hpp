@@ -1,0 +1,47 @@
+// app/profile.hpp — machine profiles (TOML): machine, stock, LBR settings and tool table.
+// Every key is documented in docs/profiles.md. Loading errors name file, line and key.
+#pragma once
+
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "geom/lbr_solid.hpp"
+#include "geom/tool.hpp"
+
+namespace lbr::app {
+
+class ProfileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Profile {
+  std::string source;  // file name, or "<built-in default>"
+  std::string name;
+  std::string machine_kind = "mill3";
+  double rapid_mm_per_min = 15000.0;
+  double tool_change_s = 0.0;
+  geom::SolidSpec solid;    // stock, Δ, region grid, chord tolerance
+  bool regions_auto = false;
+  int batch_moves = 64;     // moves per subtract() call in batch mode
+  std::map<int, geom::Tool> tools;
+};
+
+// Parses profile text; `name` is used in messages. Throws ProfileError("name:line: ...").
+[[nodiscard]] Profile parse_profile(const std::string& text, const std::string& name);
+[[nodiscard]] Profile load_profile(const std::string& path);
+// The built-in default 3-axis mill profile (config/profiles/default-mill3.toml, compiled in).
+[[nodiscard]] Profile default_profile();
+[[nodiscard]] const char* default_profile_text() noexcept;
+
+// Region grid for regions = "auto": an interim rule from stock size and tool diameter
+// (docs/profiles.md). Returns {nx, ny}.
+[[nodiscard]] std::pair<int, int> auto_region_grid(const geom::SolidSpec& solid, double max_tool_diameter_mm);
+
+// Command-line overrides, with the syntax of `lbrsim batch --help`. Throw ProfileError.
+void apply_stock_override(Profile& p, const std::string& spec);
+void apply_tool_override(Profile& p, const std::string& spec);
+void apply_regions(Profile& p, const std::string& spec, const std::string& where);
+
+}  // namespace lbr::app

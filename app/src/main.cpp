@@ -1,0 +1,112 @@
+// lbrsim — command-line entry point. Subcommands: batch, profile.
+#include <cstdio>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "app/batch.hpp"
+#include "app/outputs.hpp"
+#include "app/profile.hpp"
+
+#ifndef LBRSIM_VERSION
+#define LBRSIM_VERSION "dev"
+#endif
+
+namespace {
+
+using namespace lbr;
+
+struct BatchOptions {
+  std::string program, profile, stock, regions, out = "lbrsim-out";
+  std::vector<std::string> tools;
+  double level_spacing = 0.0;
+  bool quiet = false;
+};
+
+int run_batch_command(const BatchOptions& o) {
+  app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+  if (!o.stock.empty()) app::apply_stock_override(profile, o.stock);
+  for (const std::string& t : o.tools) app::apply_tool_override(profile, t);
+  if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
+  if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
+
+  const nc::Toolpath path = o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile);
+  const std::string program = o.program.empty() ? path.source : o.program;
+  spdlog::info("program {} ({} segments), profile {}", program, path.segments.size(), profile.source);
+
+  app::Progress progress;
+  if (!o.quiet) {
+    progress = [](double f) { spdlog::info("progress {:5.1f} %", 100.0 * f); };
+  }
+  const app::BatchResult r = app::run_batch(profile, path, progress);
+  app::write_batch_outputs(o.out, r, profile, program);
+  std::printf("removed %.3f mm3 of %.3f mm3 | machining %.2f s | simulated in %.3f s (factor %.5f) | "
+              "%d levels x %d regions (%dx%d), %zu vertices\n",
+              r.removed_volume_mm3, r.stock_volume_mm3, r.machining_time_s, r.wall_time_s,
+              r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0, r.solid.levels(), r.solid.regions(),
+              r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
+  std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"lbrsim " LBRSIM_VERSION " — NC machining simulator on a level-based representation (LBR)"};
+  cli.set_version_flag("--version", std::string("lbrsim ") + LBRSIM_VERSION);
+  cli.require_subcommand(1);
+  std::string log_level = "info";
+  cli.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+
+  BatchOptions b;
+  CLI::App* batch = cli.add_subcommand("batch", "Run a part program through the simulator as fast as possible");
+  batch->add_option("--program", b.program,
+                    "Part program: a move list (.moves); without it the bundled demo program runs");
+  batch->add_option("--profile", b.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
+  batch->add_option("--stock", b.stock,
+                    "Override the stock: box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX or cylinder:DIAMETER,ZMIN,ZMAX [mm]");
+  batch->add_option("--tool", b.tools,
+                    "Add or override tool N: N:KIND:DIAMETER[:PARAM], KIND = flat|ball|bull|drill|vbit; "
+                    "PARAM = corner radius [mm] (bull), point angle [deg] (drill), included angle [deg] (vbit)")
+      ->take_all();
+  batch->add_option("--level-spacing", b.level_spacing, "Level spacing Δ [mm]")->check(CLI::Range(0.001, 1000.0));
+  batch->add_option("--regions", b.regions, "Region grid NXxNY (e.g. 4x4) or auto");
+  batch->add_option("--out", b.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
+  batch->add_flag("--quiet", b.quiet, "No progress messages");
+
+  std::string check_path;
+  bool print_default = false;
+  CLI::App* prof = cli.add_subcommand("profile", "Check a profile, or print the built-in default profile");
+  prof->add_option("file", check_path, "Profile to check");
+  prof->add_flag("--print-default", print_default, "Print the built-in default profile");
+
+  CLI11_PARSE(cli, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(log_level));
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+
+  try {
+    if (batch->parsed()) return run_batch_command(b);
+    if (prof->parsed()) {
+      if (print_default) {
+        std::cout << app::default_profile_text();
+        return 0;
+      }
+      if (check_path.empty()) {
+        std::cerr << "lbrsim profile: give a file to check, or --print-default\n";
+        return 2;
+      }
+      const app::Profile p = app::load_profile(check_path);
+      std::printf("%s: ok (machine %s, %zu tools, level spacing %.4g mm)\n", check_path.c_str(), p.machine_kind.c_str(),
+                  p.tools.size(), p.solid.level_spacing_mm);
+      return 0;
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lbrsim: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,85 @@
+#include "app/outputs.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "demo_program.inc"  // kDemoProgram
+#include "geom/serialize.hpp"
+#include "nc/movelist.hpp"
+
+namespace lbr::app {
+
+namespace {
+
+std::string extension(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+template <class Bytes>
+void write_bytes(const std::string& path, const Bytes& bytes) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) throw std::runtime_error(path + ": cannot open for writing: " + std::strerror(errno));
+  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  f.close();
+  if (!f) throw std::runtime_error(path + ": write failed: " + std::strerror(errno));
+}
+
+}  // namespace
+
+nc::Toolpath load_toolpath(const std::string& path, const Profile& /*profile*/) {
+  const std::string ext = extension(path);
+  if (ext == ".moves") return nc::load_movelist(path);
+  if (ext == ".ngc" || ext == ".nc" || ext == ".gcode" || ext == ".tap")
+    throw std::runtime_error(path + ": G-code programs need the NC front end, which this build does not have yet; "
+                             "use a move list (.moves, docs/formats.md)");
+  throw std::runtime_error(path + ": unknown program type '" + ext + "' (expected .moves, .ngc, .nc, .gcode or .tap)");
+}
+
+nc::Toolpath demo_toolpath() { return nc::parse_movelist(kDemoProgram, "<built-in demo-pocket.moves>"); }
+
+std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program) {
+  nlohmann::json j;
+  j["program"] = program;
+  j["profile"] = profile.source;
+  j["stock_volume_mm3"] = r.stock_volume_mm3;
+  j["removed_volume_mm3"] = r.removed_volume_mm3;
+  j["final_volume_mm3"] = r.stock_volume_mm3 - r.removed_volume_mm3;
+  j["machining_time_s"] = r.machining_time_s;
+  j["wall_time_s"] = r.wall_time_s;
+  j["factor"] = r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0;
+  j["levels"] = r.solid.levels();
+  j["level_spacing_mm"] = r.solid.level_spacing_mm();
+  j["regions"] = r.solid.regions();
+  j["regions_x"] = r.solid.regions_x();
+  j["regions_y"] = r.solid.regions_y();
+  j["polygons"] = r.solid.polygon_count();
+  j["contours"] = r.solid.contour_count();
+  j["vertices"] = r.solid.vertex_count();
+  j["moves"] = r.moves;
+  j["sections"] = r.stats.sections;
+  j["cells_clipped"] = r.stats.cells_clipped;
+  j["cells_changed"] = r.stats.cells_changed;
+  j["peak_rss_mb"] = peak_rss_mb();
+  return j.dump(2) + "\n";
+}
+
+void write_file(const std::string& path, const std::string& bytes) { write_bytes(path, bytes); }
+void write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) { write_bytes(path, bytes); }
+
+void write_batch_outputs(const std::string& dir, const BatchResult& r, const Profile& profile,
+                         const std::string& program) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": cannot create output directory: " + ec.message());
+  write_file(dir + "/metrics.json", batch_metrics_json(r, profile, program));
+  write_file(dir + "/levels.lbrs", geom::to_bytes(r.solid));
+}
+
+}  // namespace lbr::app

@@ -1,0 +1,329 @@
+#include "app/profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "default_profile.inc"  // kDefaultProfileToml, generated from config/profiles/default-mill3.toml
+
+namespace lbr::app {
+
+namespace {
+
+// Reads one TOML table, remembering which keys were used so that unknown keys (typos) can
+// be reported with their line.
+class Section {
+ public:
+  Section(const toml::table& t, std::string path, const std::string& file) : t_(t), path_(std::move(path)), file_(file) {}
+
+  [[noreturn]] void fail(const toml::node* n, const std::string& key, const std::string& msg) const {
+    const auto line = n != nullptr ? n->source().begin.line : t_.source().begin.line;
+    throw ProfileError(file_ + ":" + std::to_string(line) + ": " + qualified(key) + ": " + msg);
+  }
+  [[nodiscard]] std::string qualified(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  const toml::node* get(const std::string& key) {
+    used_.insert(key);
+    return t_.get(key);
+  }
+  double number(const std::string& key, double def, double lo, double hi, const char* unit) {
+    const toml::node* n = get(key);
+    if (n == nullptr) return def;
+    double v;
+    if (auto f = n->value<double>()) v = *f;
+    else fail(n, key, std::string("expected a number [") + unit + "]");
+    if (!std::isfinite(v) || v < lo || v > hi) {
+      std::ostringstream m;
+      m << "expected a number in [" << lo << ", " << hi << "] " << unit << ", got " << v;
+      fail(n, key, m.str());
+    }
+    return v;
+  }
+  double required_number(const std::string& key, double lo, double hi, const char* unit) {
+    if (t_.get(key) == nullptr) fail(nullptr, key, std::string("missing (a number [") + unit + "] is required)");
+    return number(key, 0.0, lo, hi, unit);
+  }
+  long integer(const std::string& key, long def, long lo, long hi) {
+    const toml::node* n = get(key);
+    if (n == nullptr) return def;
+    const auto v = n->value_exact<std::int64_t>();
+    if (!v || *v < lo || *v > hi)
+      fail(n, key, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return static_cast<long>(*v);
+  }
+  std::string string(const std::string& key, const std::string& def) {
+    const toml::node* n = get(key);
+    if (n == nullptr) return def;
+    const auto v = n->value_exact<std::string>();
+    if (!v) fail(n, key, "expected a string");
+    return *v;
+  }
+  std::vector<double> numbers(const std::string& key, std::size_t count, const char* unit) {
+    const toml::node* n = get(key);
+    if (n == nullptr) fail(nullptr, key, "missing (an array of " + std::to_string(count) + " numbers [" + unit + "] is required)");
+    const toml::array* a = n->as_array();
+    if (a == nullptr || a->size() != count) fail(n, key, "expected an array of " + std::to_string(count) + " numbers [" + unit + "]");
+    std::vector<double> out;
+    for (const toml::node& e : *a) {
+      const auto v = e.value<double>();
+      if (!v || !std::isfinite(*v)) fail(&e, key, std::string("expected numbers [") + unit + "]");
+      out.push_back(*v);
+    }
+    return out;
+  }
+  const toml::table* table(const std::string& key) {
+    const toml::node* n = get(key);
+    if (n == nullptr) return nullptr;
+    if (!n->is_table()) fail(n, key, "expected a table [" + qualified(key) + "]");
+    return n->as_table();
+  }
+  void reject_unknown() const {
+    for (const auto& [k, v] : t_) {
+      const std::string key(k.str());
+      if (!used_.count(key)) fail(&v, key, "unknown key");
+    }
+  }
+  [[nodiscard]] const toml::table& raw() const { return t_; }
+
+ private:
+  const toml::table& t_;
+  std::string path_;
+  const std::string& file_;
+  std::set<std::string> used_;
+};
+
+geom::Tool read_tool(Section& s, int& number) {
+  number = static_cast<int>(s.integer("number", -1, 1, 9999));
+  if (number < 0) s.fail(nullptr, "number", "missing (every [[tool]] needs a number in [1, 9999])");
+  geom::Tool t;
+  const std::string kind = s.string("kind", "");
+  const toml::node* kn = s.raw().get("kind");
+  if (!geom::parse_tool_kind(kind, t.kind)) s.fail(kn, "kind", "expected one of flat, ball, bull, drill, vbit; got '" + kind + "'");
+  t.diameter_mm = s.required_number("diameter_mm", 0.001, 1000.0, "mm");
+  t.flute_length_mm = s.number("flute_length_mm", 3.0 * t.diameter_mm, 0.001, 5000.0, "mm");
+  t.length_mm = s.number("length_mm", std::max(t.flute_length_mm, 6.0 * t.diameter_mm), 0.001, 5000.0, "mm");
+  t.shank_diameter_mm = s.number("shank_diameter_mm", t.diameter_mm, 0.0, 1000.0, "mm");
+  t.holder_diameter_mm = s.number("holder_diameter_mm", 40.0, 0.0, 1000.0, "mm");
+  t.holder_length_mm = s.number("holder_length_mm", 40.0, 0.0, 5000.0, "mm");
+  if (t.kind == geom::ToolKind::Bull) t.corner_radius_mm = s.required_number("corner_radius_mm", 0.0, 500.0, "mm");
+  if (t.kind == geom::ToolKind::Drill) t.angle_deg = s.number("point_angle_deg", 118.0, 1.0, 179.0, "deg");
+  if (t.kind == geom::ToolKind::VBit) t.angle_deg = s.required_number("included_angle_deg", 1.0, 179.0, "deg");
+  if (const std::string e = t.validate(); !e.empty()) s.fail(nullptr, "", e);
+  s.reject_unknown();
+  return t;
+}
+
+bool parse_grid(const std::string& spec, int& nx, int& ny) {
+  const auto x = spec.find('x');
+  if (x == std::string::npos) return false;
+  try {
+    std::size_t a = 0, b = 0;
+    nx = std::stoi(spec.substr(0, x), &a);
+    ny = std::stoi(spec.substr(x + 1), &b);
+    return a == x && b == spec.size() - x - 1 && nx >= 1 && ny >= 1 && nx <= 256 && ny <= 256;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+std::vector<double> split_numbers(const std::string& s, const std::string& what) {
+  std::vector<double> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(v)) throw ProfileError(what + ": '" + item + "' is not a number");
+    out.push_back(v);
+  }
+  return out;
+}
+
+}  // namespace
+
+void apply_regions(Profile& p, const std::string& spec, const std::string& where) {
+  if (spec == "auto") {
+    p.regions_auto = true;
+    return;
+  }
+  int nx = 0, ny = 0;
+  if (!parse_grid(spec, nx, ny))
+    throw ProfileError(where + ": expected \"NXxNY\" with 1 <= NX, NY <= 256 (e.g. \"4x4\") or \"auto\", got '" + spec + "'");
+  p.regions_auto = false;
+  p.solid.regions_x = nx;
+  p.solid.regions_y = ny;
+}
+
+Profile parse_profile(const std::string& text, const std::string& name) {
+  toml::table root;
+  try {
+    root = toml::parse(text, name);
+  } catch (const toml::parse_error& e) {
+    throw ProfileError(name + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+  }
+  Profile p;
+  p.source = name;
+  Section top(root, "", name);
+
+  if (const toml::table* m = top.table("machine")) {
+    Section s(*m, "machine", name);
+    p.name = s.string("name", "");
+    p.machine_kind = s.string("kind", "mill3");
+    if (p.machine_kind != "mill3")
+      s.fail(m->get("kind"), "kind", "expected \"mill3\" (other machine kinds are not supported yet), got '" + p.machine_kind + "'");
+    p.rapid_mm_per_min = s.number("rapid_mm_per_min", 15000.0, 1.0, 1e6, "mm/min");
+    p.tool_change_s = s.number("tool_change_s", 0.0, 0.0, 3600.0, "s");
+    s.reject_unknown();
+  }
+
+  const toml::table* st = top.table("stock");
+  if (st == nullptr) top.fail(nullptr, "stock", "missing table [stock]");
+  {
+    Section s(*st, "stock", name);
+    const std::string shape = s.string("shape", "");
+    if (shape == "box") {
+      p.solid.shape = geom::SolidSpec::Shape::Box;
+      const auto lo = s.numbers("min_mm", 3, "mm");
+      const auto hi = s.numbers("max_mm", 3, "mm");
+      p.solid.box = geom::BoxStock{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+      if (!(lo[0] < hi[0] && lo[1] < hi[1] && lo[2] < hi[2]))
+        s.fail(st->get("max_mm"), "max_mm", "must be greater than min_mm on every axis");
+    } else if (shape == "cylinder") {
+      p.solid.shape = geom::SolidSpec::Shape::Cylinder;
+      const auto c = s.numbers("center_mm", 2, "mm");
+      geom::CylinderStock& cy = p.solid.cylinder;
+      cy.center_x_mm = c[0];
+      cy.center_y_mm = c[1];
+      cy.diameter_mm = s.required_number("diameter_mm", 0.001, 1e5, "mm");
+      cy.z_min_mm = s.required_number("z_min_mm", -1e5, 1e5, "mm");
+      cy.z_max_mm = s.required_number("z_max_mm", -1e5, 1e5, "mm");
+      if (!(cy.z_min_mm < cy.z_max_mm)) s.fail(st->get("z_max_mm"), "z_max_mm", "must be greater than z_min_mm");
+    } else {
+      s.fail(st->get("shape"), "shape", "expected \"box\" or \"cylinder\", got '" + shape + "'");
+    }
+    s.reject_unknown();
+  }
+
+  if (const toml::table* l = top.table("lbr")) {
+    Section s(*l, "lbr", name);
+    p.solid.level_spacing_mm = s.number("level_spacing_mm", 0.1, 0.001, 1000.0, "mm");
+    p.solid.chord_tol_mm = s.number("chord_tolerance_mm", 0.001, 0.0001, 1.0, "mm");
+    p.batch_moves = static_cast<int>(s.integer("batch_moves", 64, 1, 100000));
+    p.solid.strictly_simple = true;
+    if (const toml::node* r = s.get("regions")) {
+      const auto v = r->value_exact<std::string>();
+      if (!v) s.fail(r, "regions", "expected a string \"NXxNY\" or \"auto\"");
+      apply_regions(p, *v, name + ":" + std::to_string(r->source().begin.line) + ": lbr.regions");
+    }
+    s.reject_unknown();
+  }
+
+  if (const toml::node* tn = top.get("tool")) {
+    const toml::array* arr = tn->as_array();
+    if (arr == nullptr) top.fail(tn, "tool", "expected an array of tables [[tool]]");
+    for (const toml::node& e : *arr) {
+      if (!e.is_table()) top.fail(&e, "tool", "expected [[tool]] tables");
+      Section s(*e.as_table(), "tool", name);
+      int number = 0;
+      geom::Tool t = read_tool(s, number);
+      if (p.tools.count(number)) s.fail(e.as_table()->get("number"), "number", "tool " + std::to_string(number) + " is defined twice");
+      p.tools[number] = t;
+    }
+  }
+  top.reject_unknown();
+  return p;
+}
+
+Profile load_profile(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw ProfileError(path + ":0: cannot open profile");
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return parse_profile(ss.str(), path);
+}
+
+const char* default_profile_text() noexcept { return kDefaultProfileToml; }
+
+Profile default_profile() { return parse_profile(kDefaultProfileToml, "<built-in default-mill3>"); }
+
+std::pair<int, int> auto_region_grid(const geom::SolidSpec& solid, double max_tool_diameter_mm) {
+  double wx, wy;
+  if (solid.shape == geom::SolidSpec::Shape::Box) {
+    wx = solid.box.max.x - solid.box.min.x;
+    wy = solid.box.max.y - solid.box.min.y;
+  } else {
+    wx = wy = solid.cylinder.diameter_mm;
+  }
+  // Regions of about three tool diameters keep a single sweep within few regions while the
+  // polygons per region stay small; capped at 16 per axis (see docs/profiles.md).
+  const double side = std::max(3.0 * max_tool_diameter_mm, 1.0);
+  auto n = [&](double w) { return std::clamp(static_cast<int>(std::lround(w / side)), 1, 16); };
+  return {n(wx), n(wy)};
+}
+
+void apply_stock_override(Profile& p, const std::string& spec) {
+  const auto colon = spec.find(':');
+  const std::string kind = spec.substr(0, colon);
+  const std::string what = "--stock " + spec;
+  if (colon == std::string::npos) throw ProfileError(what + ": expected box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX or cylinder:DIAMETER,ZMIN,ZMAX");
+  const auto v = split_numbers(spec.substr(colon + 1), what);
+  if (kind == "box") {
+    if (v.size() != 6) throw ProfileError(what + ": box needs 6 numbers XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX [mm]");
+    if (!(v[0] < v[3] && v[1] < v[4] && v[2] < v[5])) throw ProfileError(what + ": box needs min < max on every axis");
+    p.solid.shape = geom::SolidSpec::Shape::Box;
+    p.solid.box = geom::BoxStock{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+  } else if (kind == "cylinder") {
+    if (v.size() != 3) throw ProfileError(what + ": cylinder needs 3 numbers DIAMETER,ZMIN,ZMAX [mm]");
+    if (!(v[0] > 0 && v[1] < v[2])) throw ProfileError(what + ": cylinder needs DIAMETER > 0 and ZMIN < ZMAX");
+    p.solid.shape = geom::SolidSpec::Shape::Cylinder;
+    p.solid.cylinder = geom::CylinderStock{0.0, 0.0, v[0], v[1], v[2]};
+  } else {
+    throw ProfileError(what + ": stock kind must be 'box' or 'cylinder', got '" + kind + "'");
+  }
+}
+
+void apply_tool_override(Profile& p, const std::string& spec) {
+  const std::string what = "--tool " + spec;
+  std::vector<std::string> f;
+  std::stringstream in(spec);
+  std::string item;
+  while (std::getline(in, item, ':')) f.push_back(item);
+  if (f.size() < 3 || f.size() > 4) throw ProfileError(what + ": expected N:KIND:DIAMETER[:PARAM]");
+  const auto num = split_numbers(f[0], what);
+  if (num.size() != 1 || num[0] < 1 || num[0] > 9999 || num[0] != std::floor(num[0]))
+    throw ProfileError(what + ": tool number must be an integer in [1, 9999]");
+  geom::Tool t;
+  if (!geom::parse_tool_kind(f[1], t.kind)) throw ProfileError(what + ": KIND must be flat, ball, bull, drill or vbit");
+  const auto d = split_numbers(f[2], what);
+  if (d.size() != 1) throw ProfileError(what + ": DIAMETER must be one number [mm]");
+  t.diameter_mm = d[0];
+  t.flute_length_mm = 3.0 * t.diameter_mm;
+  t.length_mm = std::max(t.flute_length_mm, 6.0 * t.diameter_mm);
+  t.shank_diameter_mm = t.diameter_mm;
+  const bool needs_param = t.kind == geom::ToolKind::Bull || t.kind == geom::ToolKind::VBit;
+  if (f.size() == 4) {
+    if (t.kind == geom::ToolKind::Flat || t.kind == geom::ToolKind::Ball)
+      throw ProfileError(what + ": " + f[1] + " tools take no PARAM");
+    const auto q = split_numbers(f[3], what);
+    if (q.size() != 1) throw ProfileError(what + ": PARAM must be one number");
+    if (t.kind == geom::ToolKind::Bull) t.corner_radius_mm = q[0];
+    else t.angle_deg = q[0];
+  } else if (needs_param) {
+    throw ProfileError(what + ": " + f[1] + " needs PARAM (" +
+                       (t.kind == geom::ToolKind::Bull ? "corner radius [mm]" : "included angle [deg]") + ")");
+  }
+  if (const std::string e = t.validate(); !e.empty()) throw ProfileError(what + ": " + e);
+  p.tools[static_cast<int>(num[0])] = t;
+}
+
+}  // namespace lbr::app

@@ -1,0 +1,182 @@
+// geom/lbr_solid.hpp — the level-based representation (LBR) of the stock.
+//
+// Conventions (docs/lbr-conventions.md):
+//  - Kernel units are 0.1 µm (geom/units.hpp); levels are horizontal (normal +Z) in the
+//    workpiece frame.
+//  - Level i stands for the slab [z0 + iΔ, min(z0 + (i+1)Δ, z_top)] and is sampled at the
+//    slab's mid-plane. Volume = Σ area(i) · thickness(i); every slab but possibly the top one
+//    has thickness Δ.
+//  - The stock's XY bounds are split into nx × ny equal regions (row-major, region =
+//    iy·nx + ix). A cell = (region, level) holds non-overlapping polygons with holes, all
+//    inside the region's rectangle: outer contours counter-clockwise, holes clockwise.
+//  - Every contour records the id of the move that last changed it (0 = untouched stock).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "geom/sweep.hpp"
+#include "geom/types.hpp"
+
+namespace lbr::geom {
+
+struct Contour {
+  Path pts;
+  MoveId cut_by = 0;
+};
+
+struct Polygon {
+  Contour outer;
+  std::vector<Contour> holes;
+  Rect bbox;  // of the outer contour
+};
+
+struct Cell {
+  std::vector<Polygon> polys;
+  Rect bbox;                 // of all polygons; empty when the cell holds no material
+  double area_units2 = 0.0;  // cached signed sum over contours [units²]
+  std::uint32_t version = 0; // incremented on every change
+};
+
+struct BoxStock {
+  Vec3 min, max;  // [mm]
+};
+struct CylinderStock {
+  double center_x_mm = 0, center_y_mm = 0, diameter_mm = 0, z_min_mm = 0, z_max_mm = 0;
+};
+
+struct SolidSpec {
+  enum class Shape { Box, Cylinder } shape = Shape::Box;
+  BoxStock box;
+  CylinderStock cylinder;
+  double level_spacing_mm = 0.1;  // Δ
+  int regions_x = 4, regions_y = 4;
+  double chord_tol_mm = 0.001;    // polygonisation of the cylinder's circle
+  bool strictly_simple = true;    // ask Clipper for strictly simple output (no touching vertices)
+};
+
+// One tool movement to remove: the shape must outlive the call.
+struct SweepRef {
+  const CutterShape* shape = nullptr;
+  Pose from, to;
+  MoveId id = 0;
+};
+
+struct SubtractStats {
+  std::uint64_t sections = 0;       // section polygons computed
+  std::uint64_t cells_tested = 0;   // (region, level) pairs that passed the box tests
+  std::uint64_t cells_clipped = 0;  // polygon differences executed
+  std::uint64_t cells_changed = 0;  // cells whose content changed
+  SubtractStats& operator+=(const SubtractStats& o) noexcept {
+    sections += o.sections; cells_tested += o.cells_tested;
+    cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
+    return *this;
+  }
+};
+
+// Reusable buffers for subtract(); one per thread that calls it. Grows to the largest batch
+// seen and is then reused without further allocation of its own.
+struct SubtractWorkspace {
+  ClipperLib::Clipper clipper;
+  ClipperLib::PolyTree tree;
+  SectionScratch scratch;
+  std::vector<Sweep> sweeps;
+  Paths sections;                 // section polygons of the current level
+  std::vector<Rect> section_box;  // their bounding boxes
+  std::vector<MoveId> section_id; // their move ids
+  std::vector<std::uint32_t> selected, touched;
+  std::vector<Polygon> fresh, kept;
+};
+
+class LbrSolid {
+ public:
+  // Setup: allocates all cells. Throws std::invalid_argument with a precise message when the
+  // spec is unusable (non-positive sizes, out of the safe range, too many levels/regions).
+  explicit LbrSolid(const SolidSpec& spec);
+  ~LbrSolid();
+  LbrSolid(LbrSolid&&) noexcept;
+  LbrSolid& operator=(LbrSolid&&) noexcept;
+  LbrSolid(const LbrSolid&);
+  LbrSolid& operator=(const LbrSolid&);
+
+  // Removes the union of the sweeps from the stock: per (region, level) touched, one
+  // polygon difference. Cells are skipped by bounding boxes first. Changed cells are marked
+  // dirty. Does not throw; allocates (Clipper does).
+  SubtractStats subtract(std::span<const SweepRef> batch);
+  SubtractStats subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws);
+  // Same, for the levels [level_begin, level_end) only. Levels are independent, so callers
+  // may run disjoint level ranges on several threads, each with its own workspace.
+  SubtractStats subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
+                                SubtractWorkspace& ws);
+
+  // --- geometry of the grid ---
+  [[nodiscard]] const SolidSpec& spec() const noexcept { return spec_; }
+  [[nodiscard]] int levels() const noexcept { return levels_; }
+  [[nodiscard]] int regions_x() const noexcept { return spec_.regions_x; }
+  [[nodiscard]] int regions_y() const noexcept { return spec_.regions_y; }
+  [[nodiscard]] int regions() const noexcept { return spec_.regions_x * spec_.regions_y; }
+  [[nodiscard]] double level_spacing_mm() const noexcept { return spec_.level_spacing_mm; }
+  [[nodiscard]] double z_bottom_mm() const noexcept { return z0_; }
+  [[nodiscard]] double z_top_mm() const noexcept { return z1_; }
+  [[nodiscard]] double level_z_mm(int level) const noexcept;          // mid-plane
+  [[nodiscard]] double level_thickness_mm(int level) const noexcept;
+  [[nodiscard]] double level_bottom_mm(int level) const noexcept;
+  // Level whose slab contains z (clamped to [0, levels()-1]).
+  [[nodiscard]] int level_at(double z_mm) const noexcept;
+  [[nodiscard]] Rect region_rect(int region) const noexcept;
+  [[nodiscard]] Rect stock_rect() const noexcept { return xy_; }
+
+  // --- contents ---
+  [[nodiscard]] const Cell& cell(int region, int level) const noexcept {
+    return cells_[static_cast<std::size_t>(region) * levels_ + level];
+  }
+  [[nodiscard]] double volume_mm3() const noexcept;
+  [[nodiscard]] double initial_volume_mm3() const noexcept { return initial_volume_mm3_; }
+  [[nodiscard]] double level_area_mm2(int level) const noexcept;
+  // Bounds of the remaining material [mm] (z from the slabs that hold material).
+  [[nodiscard]] Box3 bounds() const noexcept;
+  [[nodiscard]] std::size_t polygon_count() const noexcept;
+  [[nodiscard]] std::size_t contour_count() const noexcept;
+  [[nodiscard]] std::size_t vertex_count() const noexcept;
+
+  // --- dirty set: cells changed since the last clear_dirty() ---
+  [[nodiscard]] bool is_dirty(int region, int level) const noexcept {
+    return dirty_flag_[static_cast<std::size_t>(region) * levels_ + level] != 0;
+  }
+  // Cell indices (region * levels() + level), ascending. Allocates; not for the RT path.
+  [[nodiscard]] std::vector<std::uint32_t> dirty_cells() const;
+  [[nodiscard]] std::size_t dirty_count() const noexcept;
+  void clear_dirty() noexcept;
+
+  // Empty string when every cell satisfies the representation invariants (contours inside
+  // their region, outers CCW and holes CW, contours simple, polygons non-overlapping);
+  // otherwise a description of the first violation. Slow; for tests and diagnostics.
+  [[nodiscard]] std::string check_invariants() const;
+
+  // Replaces the content of one cell (used by deserialisation and tests). Marks it dirty.
+  void set_cell(int region, int level, std::vector<Polygon> polys);
+
+ private:
+  void init_cells();
+  SubtractStats subtract_level(std::span<const SweepRef> batch, int level, SubtractWorkspace& ws);
+
+  SolidSpec spec_;
+  int levels_ = 0;
+  double z0_ = 0, z1_ = 0;
+  Rect xy_;
+  std::vector<Coord> xs_, ys_;  // region boundaries, nx+1 and ny+1 values
+  std::vector<Cell> cells_;
+  std::vector<std::uint8_t> dirty_flag_;
+  double initial_volume_mm3_ = 0;
+  std::unique_ptr<SubtractWorkspace> ws_;
+};
+
+// Fills `out` with the polygons of `cell` as a flat list of contours (outer then holes).
+void flatten(const Cell& cell, Paths& out);
+// Signed area [units²] of a path (positive for counter-clockwise).
+[[nodiscard]] double signed_area(const Path& p) noexcept;
+
+}  // namespace lbr::geom

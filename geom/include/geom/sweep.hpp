@@ -1,0 +1,78 @@
+// geom/sweep.hpp — cross-sections of a tool moving between two poses.
+//
+// The tool pose is interpolated linearly between the two poses (tip linearly, axis by
+// normalised linear interpolation). The swept solid is cut by horizontal planes z = const
+// (the level planes); the result is a set of convex polygons whose union is the section.
+//
+// Accuracy: with the tool's cutting profile replaced by its piecewise-linear CutterShape, a
+// straight move with a fixed axis sweeps a convex solid and the section is computed
+// exactly up to the polygonisation of circles, which keeps every boundary point within the
+// chord tolerance of the exact section. For a flat end mill the linear profile is exact, so
+// the only error is polygonisation. Moves whose axis changes are subdivided so that no
+// point of the tool leaves the chord tolerance of the linear interpolation between
+// sub-steps.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "geom/tool.hpp"
+#include "geom/types.hpp"
+
+namespace lbr::geom {
+
+// Reusable buffers for Sweep::section(); grows to the largest section seen, then stops
+// allocating. One per thread.
+struct SectionScratch {
+  struct P2 {
+    double x, y;
+  };
+  std::vector<P2> pts;
+  std::vector<P2> hull;
+  struct Disk {
+    double x, y, r;
+  };
+  std::vector<Disk> disks;
+  struct Dir {
+    double phi;
+    P2 p;
+  };
+  std::vector<Dir> dirs;
+};
+
+class Sweep {
+ public:
+  // Does not allocate beyond the sub-step list (fixed capacity). Real-time safe.
+  Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcept;
+
+  // Height range [mm] touched by the cutting part of the sweep.
+  [[nodiscard]] double z_min() const noexcept { return box_.lo.z; }
+  [[nodiscard]] double z_max() const noexcept { return box_.hi.z; }
+  // 3D bounding box of the cutting part [mm].
+  [[nodiscard]] const Box3& bounds() const noexcept { return box_; }
+  // True when both poses have the axis exactly +Z (the 3-axis fast path).
+  [[nodiscard]] bool vertical() const noexcept { return vertical_; }
+
+  // Appends the section on plane z = z_mm as convex polygons (counter-clockwise, kernel
+  // units) to out; returns how many were appended. `scratch` is reused between calls to
+  // avoid allocation once it has grown. Real-time safe once the buffers have grown.
+  std::size_t section(double z_mm, Paths& out, SectionScratch& scratch) const;
+
+  // Number of polygon vertices used for a full circle of radius r [mm] at the shape's chord
+  // tolerance (at least 8, at most 4096).
+  [[nodiscard]] static int circle_segments(double r_mm, double chord_tol_mm) noexcept;
+
+  static constexpr int kMaxSubsteps = 256;
+
+ private:
+  std::size_t section_vertical(double z_mm, Paths& out, SectionScratch& scratch) const;
+  std::size_t section_general(double z_mm, Paths& out, SectionScratch& scratch) const;
+
+  const CutterShape* shape_;
+  Pose from_, to_;
+  bool vertical_ = true;
+  int substeps_ = 1;
+  Box3 box_;
+};
+
+}  // namespace lbr::geom

@@ -1,0 +1,422 @@
+// LbrSolid: construction of the stock, subtraction of sweeps, queries.
+#include "geom/lbr_solid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "polygon_ops.hpp"
+
+namespace lbr::geom {
+
+namespace {
+
+constexpr int kMaxRegionsPerAxis = 256;
+constexpr long kMaxLevels = 200000;
+constexpr long kMaxCells = 8000000;
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+
+bool in_range(double mm) { return std::isfinite(mm) && std::abs(mm) <= kSafeRangeMm; }
+
+Path rect_path(const Rect& r) {
+  return Path{{r.x0, r.y0}, {r.x1, r.y0}, {r.x1, r.y1}, {r.x0, r.y1}};
+}
+
+// Index of the interval [b[i], b[i+1]] holding v, clamped to [0, b.size()-2].
+int interval_of(const std::vector<Coord>& b, Coord v) noexcept {
+  const auto it = std::upper_bound(b.begin(), b.end(), v);
+  const long i = static_cast<long>(it - b.begin()) - 1;
+  return static_cast<int>(std::clamp<long>(i, 0, static_cast<long>(b.size()) - 2));
+}
+
+}  // namespace
+
+LbrSolid::LbrSolid(const SolidSpec& spec) : spec_(spec), ws_(std::make_unique<SubtractWorkspace>()) {
+  std::ostringstream m;
+  require(std::isfinite(spec.level_spacing_mm) && spec.level_spacing_mm >= 0.001 && spec.level_spacing_mm <= 1000.0,
+          "level spacing must be in [0.001, 1000] mm");
+  require(spec.regions_x >= 1 && spec.regions_x <= kMaxRegionsPerAxis && spec.regions_y >= 1 &&
+              spec.regions_y <= kMaxRegionsPerAxis,
+          "region grid must be between 1x1 and 256x256");
+  require(std::isfinite(spec.chord_tol_mm) && spec.chord_tol_mm >= 1e-4 && spec.chord_tol_mm <= 1.0,
+          "chord tolerance must be in [0.0001, 1] mm");
+  if (spec.shape == SolidSpec::Shape::Box) {
+    const BoxStock& b = spec.box;
+    for (double v : {b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z})
+      require(in_range(v), "box stock coordinates must be finite and within ±" + std::to_string(kSafeRangeMm) + " mm");
+    require(b.min.x < b.max.x && b.min.y < b.max.y && b.min.z < b.max.z, "box stock needs min < max on every axis");
+    z0_ = b.min.z;
+    z1_ = b.max.z;
+    xy_ = Rect{to_units(b.min.x), to_units(b.min.y), to_units(b.max.x), to_units(b.max.y)};
+  } else {
+    const CylinderStock& c = spec.cylinder;
+    require(std::isfinite(c.diameter_mm) && c.diameter_mm > 0.0, "cylinder stock needs a diameter > 0");
+    for (double v : {c.center_x_mm - c.diameter_mm, c.center_x_mm + c.diameter_mm, c.center_y_mm - c.diameter_mm,
+                     c.center_y_mm + c.diameter_mm, c.z_min_mm, c.z_max_mm})
+      require(in_range(v), "cylinder stock must lie within ±" + std::to_string(kSafeRangeMm) + " mm");
+    require(c.z_min_mm < c.z_max_mm, "cylinder stock needs z_min < z_max");
+    z0_ = c.z_min_mm;
+    z1_ = c.z_max_mm;
+    const double r = 0.5 * c.diameter_mm;
+    xy_ = Rect{to_units(c.center_x_mm - r), to_units(c.center_y_mm - r), to_units(c.center_x_mm + r),
+               to_units(c.center_y_mm + r)};
+  }
+  const double n = std::ceil((z1_ - z0_) / spec.level_spacing_mm - 1e-9);
+  require(n >= 1 && n <= kMaxLevels, "stock height / level spacing gives " + std::to_string(static_cast<long>(n)) +
+                                         " levels; at most " + std::to_string(kMaxLevels) + " are supported");
+  levels_ = static_cast<int>(n);
+  require(static_cast<long>(levels_) * regions() <= kMaxCells,
+          "levels x regions = " + std::to_string(static_cast<long>(levels_) * regions()) + " cells; at most " +
+              std::to_string(kMaxCells) + " are supported");
+  init_cells();
+}
+
+LbrSolid::~LbrSolid() = default;
+LbrSolid::LbrSolid(LbrSolid&&) noexcept = default;
+LbrSolid& LbrSolid::operator=(LbrSolid&&) noexcept = default;
+LbrSolid::LbrSolid(const LbrSolid& o)
+    : spec_(o.spec_), levels_(o.levels_), z0_(o.z0_), z1_(o.z1_), xy_(o.xy_), xs_(o.xs_), ys_(o.ys_),
+      cells_(o.cells_), dirty_flag_(o.dirty_flag_), initial_volume_mm3_(o.initial_volume_mm3_),
+      ws_(std::make_unique<SubtractWorkspace>()) {}
+LbrSolid& LbrSolid::operator=(const LbrSolid& o) {
+  if (this != &o) *this = LbrSolid(o);
+  return *this;
+}
+
+void LbrSolid::init_cells() {
+  const int nx = spec_.regions_x, ny = spec_.regions_y;
+  xs_.resize(nx + 1);
+  ys_.resize(ny + 1);
+  for (int i = 0; i <= nx; ++i) xs_[i] = xy_.x0 + (xy_.x1 - xy_.x0) * i / nx;
+  for (int j = 0; j <= ny; ++j) ys_[j] = xy_.y0 + (xy_.y1 - xy_.y0) * j / ny;
+
+  Path circle;
+  if (spec_.shape == SolidSpec::Shape::Cylinder) {
+    const CylinderStock& c = spec_.cylinder;
+    const double r = 0.5 * c.diameter_mm;
+    const int segs = Sweep::circle_segments(r, spec_.chord_tol_mm);
+    const double rho = r * 2.0 / (1.0 + std::cos(std::numbers::pi / segs));
+    for (int k = 0; k < segs; ++k) {
+      const double a = 2.0 * std::numbers::pi * k / segs;
+      circle.push_back({to_units(c.center_x_mm + rho * std::cos(a)), to_units(c.center_y_mm + rho * std::sin(a))});
+    }
+  }
+  cells_.assign(static_cast<std::size_t>(regions()) * levels_, Cell{});
+  dirty_flag_.assign(cells_.size(), 0);
+  for (int reg = 0; reg < regions(); ++reg) {
+    const Rect rr = region_rect(reg);
+    std::vector<Polygon> polys;
+    if (spec_.shape == SolidSpec::Shape::Box) {
+      Polygon p;
+      p.outer.pts = rect_path(rr);
+      p.bbox = rr;
+      polys.push_back(std::move(p));
+    } else {
+      ClipperLib::Clipper c;
+      c.AddPath(circle, ClipperLib::ptSubject, true);
+      c.AddPath(rect_path(rr), ClipperLib::ptClip, true);
+      ClipperLib::PolyTree tree;
+      c.Execute(ClipperLib::ctIntersection, tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+      detail::append_polygons(tree, polys);
+    }
+    for (int l = 0; l < levels_; ++l) {
+      Cell& cell = cells_[static_cast<std::size_t>(reg) * levels_ + l];
+      cell.polys = polys;
+      detail::refresh_cell(cell);
+    }
+  }
+  initial_volume_mm3_ = volume_mm3();
+}
+
+double LbrSolid::level_bottom_mm(int level) const noexcept { return z0_ + level * spec_.level_spacing_mm; }
+
+double LbrSolid::level_thickness_mm(int level) const noexcept {
+  return std::min(z1_, level_bottom_mm(level + 1)) - level_bottom_mm(level);
+}
+
+double LbrSolid::level_z_mm(int level) const noexcept {
+  return level_bottom_mm(level) + 0.5 * level_thickness_mm(level);
+}
+
+int LbrSolid::level_at(double z_mm) const noexcept {
+  const double f = std::floor((z_mm - z0_) / spec_.level_spacing_mm);
+  return static_cast<int>(std::clamp(f, 0.0, static_cast<double>(levels_ - 1)));
+}
+
+Rect LbrSolid::region_rect(int region) const noexcept {
+  const int ix = region % spec_.regions_x, iy = region / spec_.regions_x;
+  return Rect{xs_[ix], ys_[iy], xs_[ix + 1], ys_[iy + 1]};
+}
+
+double LbrSolid::volume_mm3() const noexcept {
+  double v = 0.0;
+  for (int l = 0; l < levels_; ++l) v += level_area_mm2(l) * level_thickness_mm(l);
+  return v;
+}
+
+double LbrSolid::level_area_mm2(int level) const noexcept {
+  double a = 0.0;
+  for (int r = 0; r < regions(); ++r) a += cell(r, level).area_units2;
+  return area_to_mm2(a);
+}
+
+Box3 LbrSolid::bounds() const noexcept {
+  Box3 b;
+  for (int l = 0; l < levels_; ++l) {
+    for (int r = 0; r < regions(); ++r) {
+      const Cell& c = cell(r, l);
+      if (c.bbox.empty()) continue;
+      b.add({to_mm(c.bbox.x0), to_mm(c.bbox.y0), level_bottom_mm(l)});
+      b.add({to_mm(c.bbox.x1), to_mm(c.bbox.y1), level_bottom_mm(l) + level_thickness_mm(l)});
+    }
+  }
+  return b;
+}
+
+std::size_t LbrSolid::polygon_count() const noexcept {
+  std::size_t n = 0;
+  for (const Cell& c : cells_) n += c.polys.size();
+  return n;
+}
+
+std::size_t LbrSolid::contour_count() const noexcept {
+  std::size_t n = 0;
+  for (const Cell& c : cells_)
+    for (const Polygon& p : c.polys) n += 1 + p.holes.size();
+  return n;
+}
+
+std::size_t LbrSolid::vertex_count() const noexcept {
+  std::size_t n = 0;
+  for (const Cell& c : cells_)
+    for (const Polygon& p : c.polys) {
+      n += p.outer.pts.size();
+      for (const Contour& h : p.holes) n += h.pts.size();
+    }
+  return n;
+}
+
+std::vector<std::uint32_t> LbrSolid::dirty_cells() const {
+  std::vector<std::uint32_t> out;
+  for (std::size_t i = 0; i < dirty_flag_.size(); ++i)
+    if (dirty_flag_[i]) out.push_back(static_cast<std::uint32_t>(i));
+  return out;
+}
+
+std::size_t LbrSolid::dirty_count() const noexcept {
+  return static_cast<std::size_t>(std::count(dirty_flag_.begin(), dirty_flag_.end(), std::uint8_t{1}));
+}
+
+void LbrSolid::clear_dirty() noexcept { std::fill(dirty_flag_.begin(), dirty_flag_.end(), std::uint8_t{0}); }
+
+void LbrSolid::set_cell(int region, int level, std::vector<Polygon> polys) {
+  const std::size_t i = static_cast<std::size_t>(region) * levels_ + level;
+  Cell& c = cells_[i];
+  c.polys = std::move(polys);
+  for (Polygon& p : c.polys) p.bbox = bounds_of(p.outer.pts);
+  detail::refresh_cell(c);
+  ++c.version;
+  dirty_flag_[i] = 1;
+}
+
+SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch) { return subtract(batch, *ws_); }
+
+SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws) {
+  return subtract_levels(batch, 0, levels_, ws);
+}
+
+SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
+                                        SubtractWorkspace& ws) {
+  SubtractStats stats;
+  ws.sweeps.clear();
+  double zlo = INFINITY, zhi = -INFINITY;
+  for (const SweepRef& s : batch) {
+    if (s.shape == nullptr) continue;
+    ws.sweeps.emplace_back(*s.shape, s.from, s.to);
+    zlo = std::min(zlo, ws.sweeps.back().z_min());
+    zhi = std::max(zhi, ws.sweeps.back().z_max());
+  }
+  if (ws.sweeps.empty() || zhi < z0_ || zlo > z1_) return stats;
+  const int lb = std::max(level_begin, level_at(zlo));
+  const int le = std::min(level_end, level_at(zhi) + 1);
+  for (int l = lb; l < le; ++l) stats += subtract_level(batch, l, ws);
+  return stats;
+}
+
+SubtractStats LbrSolid::subtract_level(std::span<const SweepRef> batch, int level, SubtractWorkspace& ws) {
+  SubtractStats stats;
+  const double zc = level_z_mm(level);
+  ws.sections.clear();
+  ws.section_box.clear();
+  ws.section_id.clear();
+  Rect all;
+  {
+    std::size_t si = 0;
+    for (const SweepRef& s : batch) {
+      if (s.shape == nullptr) continue;
+      const Sweep& sw = ws.sweeps[si++];
+      if (zc < sw.z_min() || zc > sw.z_max()) continue;
+      const std::size_t before = ws.sections.size();
+      sw.section(zc, ws.sections, ws.scratch);
+      for (std::size_t k = before; k < ws.sections.size(); ++k) {
+        ws.section_box.push_back(bounds_of(ws.sections[k]));
+        ws.section_id.push_back(s.id);
+        all.add(ws.section_box.back());
+      }
+    }
+  }
+  stats.sections = ws.sections.size();
+  if (ws.sections.empty() || !all.intersects(xy_)) return stats;
+
+  const int ix0 = interval_of(xs_, all.x0), ix1 = interval_of(xs_, all.x1);
+  const int iy0 = interval_of(ys_, all.y0), iy1 = interval_of(ys_, all.y1);
+  for (int iy = iy0; iy <= iy1; ++iy) {
+    for (int ix = ix0; ix <= ix1; ++ix) {
+      const int region = iy * spec_.regions_x + ix;
+      const std::size_t ci = static_cast<std::size_t>(region) * levels_ + level;
+      Cell& cell = cells_[ci];
+      if (!cell.bbox.intersects(all)) continue;
+      ++stats.cells_tested;
+      ws.selected.clear();
+      Rect clipbox;
+      for (std::uint32_t k = 0; k < ws.sections.size(); ++k) {
+        if (ws.section_box[k].intersects(cell.bbox)) {
+          ws.selected.push_back(k);
+          clipbox.add(ws.section_box[k]);
+        }
+      }
+      if (ws.selected.empty()) continue;
+      ws.touched.clear();
+      for (std::uint32_t p = 0; p < cell.polys.size(); ++p)
+        if (cell.polys[p].bbox.intersects(clipbox)) ws.touched.push_back(p);
+      if (ws.touched.empty()) continue;
+
+      ClipperLib::Clipper& c = ws.clipper;
+      c.Clear();
+      c.StrictlySimple(spec_.strictly_simple);
+      for (std::uint32_t p : ws.touched) {
+        c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
+        for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
+      }
+      for (std::uint32_t k : ws.selected) c.AddPath(ws.sections[k], ClipperLib::ptClip, true);
+      ws.tree.Clear();
+      c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+      ++stats.cells_clipped;
+      ws.fresh.clear();
+      detail::append_polygons(ws.tree, ws.fresh);
+
+      // Carry the move id over to contours that came out unchanged; a new or changed
+      // contour takes the latest move among the sections that overlap it.
+      bool changed = ws.fresh.size() != ws.touched.size();
+      auto inherit = [&](Contour& out, const Rect& box) {
+        for (std::uint32_t p : ws.touched) {
+          const Polygon& old = cell.polys[p];
+          if (old.bbox == box && detail::same_cycle(old.outer.pts, out.pts)) {
+            out.cut_by = old.outer.cut_by;
+            return;
+          }
+          for (const Contour& h : old.holes) {
+            if (h.pts.size() == out.pts.size() && detail::same_cycle(h.pts, out.pts)) {
+              out.cut_by = h.cut_by;
+              return;
+            }
+          }
+        }
+        changed = true;
+        MoveId id = 0;
+        for (std::uint32_t k : ws.selected)
+          if (ws.section_box[k].intersects(box)) id = std::max(id, ws.section_id[k]);
+        if (id == 0)
+          for (std::uint32_t k : ws.selected) id = std::max(id, ws.section_id[k]);
+        out.cut_by = id;
+      };
+      for (Polygon& poly : ws.fresh) {
+        inherit(poly.outer, poly.bbox);
+        for (Contour& h : poly.holes) inherit(h, bounds_of(h.pts));
+      }
+      if (!changed) continue;
+
+      // Keep the untouched polygons, then append the new ones.
+      ws.kept.clear();
+      std::size_t t = 0;
+      for (std::uint32_t p = 0; p < cell.polys.size(); ++p) {
+        if (t < ws.touched.size() && ws.touched[t] == p) {
+          ++t;
+          continue;
+        }
+        ws.kept.push_back(std::move(cell.polys[p]));
+      }
+      for (Polygon& poly : ws.fresh) ws.kept.push_back(std::move(poly));
+      cell.polys.swap(ws.kept);
+      detail::refresh_cell(cell);
+      ++cell.version;
+      dirty_flag_[ci] = 1;
+      ++stats.cells_changed;
+    }
+  }
+  return stats;
+}
+
+std::string LbrSolid::check_invariants() const {
+  std::ostringstream e;
+  for (int reg = 0; reg < regions(); ++reg) {
+    const Rect rr = region_rect(reg);
+    for (int l = 0; l < levels_; ++l) {
+      const Cell& c = cell(reg, l);
+      double sum = 0.0;
+      Paths all;
+      for (std::size_t pi = 0; pi < c.polys.size(); ++pi) {
+        const Polygon& p = c.polys[pi];
+        auto where = [&] { return "region " + std::to_string(reg) + " level " + std::to_string(l) + " polygon " + std::to_string(pi); };
+        if (p.outer.pts.size() < 3) return where() + ": outer contour has fewer than 3 vertices";
+        if (ClipperLib::Area(p.outer.pts) <= 0.0) return where() + ": outer contour is not counter-clockwise";
+        if (!(p.bbox == bounds_of(p.outer.pts))) return where() + ": stale bounding box";
+        for (const Contour& h : p.holes)
+          if (ClipperLib::Area(h.pts) >= 0.0) return where() + ": hole is not clockwise";
+        for (const Path* path = &p.outer.pts; path != nullptr; path = nullptr) {
+          for (const Point& q : *path)
+            if (q.X < rr.x0 || q.X > rr.x1 || q.Y < rr.y0 || q.Y > rr.y1) return where() + ": vertex outside its region";
+        }
+        // A simple contour is its own simplification, with the same area.
+        auto simple = [](const Path& path) {
+          Paths out;
+          ClipperLib::SimplifyPolygon(path, out, ClipperLib::pftNonZero);
+          double a = 0.0;
+          for (const Path& q : out) a += std::abs(ClipperLib::Area(q));
+          return std::abs(a - std::abs(ClipperLib::Area(path))) <= 1.0;
+        };
+        if (!simple(p.outer.pts)) return where() + ": outer contour self-intersects";
+        for (const Contour& h : p.holes)
+          if (!simple(h.pts)) return where() + ": hole self-intersects";
+        all.push_back(p.outer.pts);
+        sum += ClipperLib::Area(p.outer.pts);
+        for (const Contour& h : p.holes) {
+          all.push_back(h.pts);
+          sum += ClipperLib::Area(h.pts);
+        }
+      }
+      if (all.empty()) continue;
+      // Non-overlap: the union's area equals the sum of the polygons' areas. Holes outside
+      // their outer contour would make the two differ as well.
+      ClipperLib::Clipper u;
+      u.AddPaths(all, ClipperLib::ptSubject, true);
+      Paths un;
+      u.Execute(ClipperLib::ctUnion, un, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+      double ua = 0.0;
+      for (const Path& q : un) ua += ClipperLib::Area(q);
+      if (std::abs(ua - sum) > 1.0 + 1e-9 * std::abs(sum))
+        return "region " + std::to_string(reg) + " level " + std::to_string(l) + ": polygons overlap (union area " +
+               std::to_string(ua) + " != sum " + std::to_string(sum) + ")";
+      if (std::abs(sum - c.area_units2) > 1.0 + 1e-9 * std::abs(sum))
+        return "region " + std::to_string(reg) + " level " + std::to_string(l) + ": stale cached area";
+    }
+  }
+  return {};
+}
+
+}  // namespace lbr::geom

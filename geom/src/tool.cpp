@@ -1,0 +1,153 @@
+// Tool profiles: exact r(h) and its piecewise-linear approximation within the chord tolerance.
+#include "geom/tool.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+namespace lbr::geom {
+
+const char* to_string(ToolKind k) noexcept {
+  switch (k) {
+    case ToolKind::Flat: return "flat";
+    case ToolKind::Ball: return "ball";
+    case ToolKind::Bull: return "bull";
+    case ToolKind::Drill: return "drill";
+    case ToolKind::VBit: return "vbit";
+  }
+  return "?";
+}
+
+bool parse_tool_kind(const std::string& s, ToolKind& out) noexcept {
+  for (ToolKind k : {ToolKind::Flat, ToolKind::Ball, ToolKind::Bull, ToolKind::Drill, ToolKind::VBit}) {
+    if (s == to_string(k)) {
+      out = k;
+      return true;
+    }
+  }
+  return false;
+}
+
+namespace {
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Corner radius of the profile's rounded part (0 for cones and flat).
+double corner_radius(const Tool& t) noexcept {
+  switch (t.kind) {
+    case ToolKind::Ball: return 0.5 * t.diameter_mm;
+    case ToolKind::Bull: return t.corner_radius_mm;
+    default: return 0.0;
+  }
+}
+}  // namespace
+
+std::string Tool::validate() const {
+  std::ostringstream e;
+  const double r = 0.5 * diameter_mm;
+  if (!(diameter_mm > 0.0) || !std::isfinite(diameter_mm))
+    e << "diameter_mm must be > 0 (got " << diameter_mm << ")";
+  else if (!(flute_length_mm > 0.0) || !std::isfinite(flute_length_mm))
+    e << "flute_length_mm must be > 0 (got " << flute_length_mm << ")";
+  else if (length_mm < flute_length_mm)
+    e << "length_mm (" << length_mm << ") must be >= flute_length_mm (" << flute_length_mm << ")";
+  else if (kind == ToolKind::Bull && !(corner_radius_mm > 0.0 && corner_radius_mm <= r))
+    e << "corner_radius_mm must be in (0, diameter/2 = " << r << "] (got " << corner_radius_mm << ")";
+  else if ((kind == ToolKind::Drill || kind == ToolKind::VBit) && !(angle_deg > 0.0 && angle_deg < 180.0))
+    e << (kind == ToolKind::Drill ? "point" : "included") << " angle must be in (0, 180) degrees (got "
+      << angle_deg << ")";
+  else if (shank_diameter_mm < 0.0 || holder_diameter_mm < 0.0 || holder_length_mm < 0.0)
+    e << "shank and holder dimensions must be >= 0";
+  return e.str();
+}
+
+double Tool::full_radius_height() const noexcept {
+  const double r = 0.5 * diameter_mm;
+  switch (kind) {
+    case ToolKind::Flat: return 0.0;
+    case ToolKind::Ball:
+    case ToolKind::Bull: return corner_radius(*this);
+    case ToolKind::Drill:
+    case ToolKind::VBit: return r / std::tan(0.5 * angle_deg * kDeg);
+  }
+  return 0.0;
+}
+
+double Tool::radius_at(double h) const noexcept {
+  if (h < 0.0 || h > flute_length_mm) return 0.0;
+  const double r = 0.5 * diameter_mm;
+  switch (kind) {
+    case ToolKind::Flat: return r;
+    case ToolKind::Ball:
+    case ToolKind::Bull: {
+      const double rc = corner_radius(*this);
+      if (h >= rc) return r;
+      const double d = rc - h;
+      return (r - rc) + std::sqrt(std::max(0.0, rc * rc - d * d));
+    }
+    case ToolKind::Drill:
+    case ToolKind::VBit: return std::min(r, h * std::tan(0.5 * angle_deg * kDeg));
+  }
+  return 0.0;
+}
+
+CutterShape CutterShape::build(const Tool& tool, double chord_tol_mm) {
+  CutterShape s;
+  s.tool = tool;
+  s.chord_tol_mm = chord_tol_mm;
+  const double r = 0.5 * tool.diameter_mm;
+  const double top = tool.flute_length_mm;
+  auto push = [&](double h, double rad) {
+    h = std::min(h, top);
+    if (!s.stations.empty() && h <= s.stations.back().h) return;
+    s.stations.push_back({h, rad});
+  };
+  switch (tool.kind) {
+    case ToolKind::Flat:
+      push(0.0, r);
+      break;
+    case ToolKind::Ball:
+    case ToolKind::Bull: {
+      const double rc = corner_radius(tool);
+      // Inscribed polyline on the corner arc, angle step chosen so the sagitta <= tol.
+      const double step = 2.0 * std::acos(std::max(-1.0, 1.0 - chord_tol_mm / rc));
+      const int n = std::max(2, static_cast<int>(std::ceil(0.5 * std::numbers::pi / step)));
+      for (int i = 0; i <= n; ++i) {
+        const double a = 0.5 * std::numbers::pi * i / n;
+        const double h = rc * (1.0 - std::cos(a));
+        if (h > top) {
+          push(top, tool.radius_at(top));
+          break;
+        }
+        push(h, (r - rc) + rc * std::sin(a));
+      }
+      break;
+    }
+    case ToolKind::Drill:
+    case ToolKind::VBit: {
+      push(0.0, 0.0);
+      const double hc = tool.full_radius_height();
+      if (hc < top) push(hc, r);
+      else push(top, tool.radius_at(top));
+      break;
+    }
+  }
+  if (s.stations.back().h < top) s.stations.push_back({top, s.stations.back().r});
+  return s;
+}
+
+double CutterShape::radius_at(double h) const noexcept {
+  if (h < 0.0 || h > stations.back().h) return 0.0;
+  // Few stations (tens): a linear scan is cheaper than a binary search here.
+  for (std::size_t i = 1; i < stations.size(); ++i) {
+    if (h <= stations[i].h) {
+      const Station& a = stations[i - 1];
+      const Station& b = stations[i];
+      const double t = (h - a.h) / (b.h - a.h);
+      return a.r + t * (b.r - a.r);
+    }
+  }
+  return stations.back().r;
+}
+
+}  // namespace lbr::geom

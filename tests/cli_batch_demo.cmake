@@ -1,0 +1,45 @@
+# Runs `lbrsim batch` on the built-in demo and checks metrics.json and the levels file;
+# then checks that bad input fails with a precise message.
+file(REMOVE_RECURSE "${OUT}")
+execute_process(COMMAND "${LBRSIM}" batch --quiet --out "${OUT}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "lbrsim batch failed (${rc}): ${out} ${err}")
+endif()
+file(READ "${OUT}/metrics.json" metrics)
+foreach(key removed_volume_mm3 stock_volume_mm3 machining_time_s wall_time_s factor levels regions vertices peak_rss_mb)
+  string(JSON v ERROR_VARIABLE jerr GET "${metrics}" ${key})
+  if(jerr)
+    message(FATAL_ERROR "metrics.json lacks ${key}: ${metrics}")
+  endif()
+endforeach()
+string(JSON stock GET "${metrics}" stock_volume_mm3)
+string(JSON levels GET "${metrics}" levels)
+string(JSON removed GET "${metrics}" removed_volume_mm3)
+# 100 x 80 x 30 mm box at Δ = 0.1 mm.
+if(NOT levels EQUAL 300)
+  message(FATAL_ERROR "expected 300 levels, got ${levels}")
+endif()
+if(stock LESS 239999.9 OR stock GREATER 240000.1)
+  message(FATAL_ERROR "expected stock volume 240000 mm3, got ${stock}")
+endif()
+# Hand count of the demo (docs/formats.md): facing 8000, pocket ~19030, shoulder 15300,
+# grooves, holes and chamfer ~4400 mm3.
+if(removed LESS 45500 OR removed GREATER 47500)
+  message(FATAL_ERROR "removed volume ${removed} mm3 outside [45500, 47500]")
+endif()
+if(NOT EXISTS "${OUT}/levels.lbrs")
+  message(FATAL_ERROR "levels.lbrs missing")
+endif()
+
+# A broken profile names file, line and key.
+file(WRITE "${OUT}/bad.toml" "[stock]\nshape = \"box\"\nmin_mm = [0, 0, 0]\nmax_mm = [10, 10, 10]\n\n[lbr]\nlevel_spacing_mm = -1\n")
+execute_process(COMMAND "${LBRSIM}" batch --quiet --profile "${OUT}/bad.toml" --out "${OUT}/x" RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "bad.toml:7: lbr.level_spacing_mm: expected a number in")
+  message(FATAL_ERROR "bad profile not reported as expected (rc ${rc}): ${err}")
+endif()
+# A broken move list names file and line.
+file(WRITE "${OUT}/bad.moves" "lbr-moves 1\ntool 1\nfeed 100\nline 0 0 zero\n")
+execute_process(COMMAND "${LBRSIM}" batch --quiet --program "${OUT}/bad.moves" --out "${OUT}/y" RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "bad.moves:4: 'line': a coordinate must be a finite number, got 'zero'")
+  message(FATAL_ERROR "bad move list not reported as expected (rc ${rc}): ${err}")
+endif()

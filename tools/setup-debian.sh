@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package lbrsim needs to build, run, test and benchmark.
+# Idempotent: installs only what is missing. Runs as root, or through sudo when available.
+set -euo pipefail
+
+PACKAGES=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git
+  # libraries (found by CMake find_package / pkg-config)
+  libpolyclipping-dev libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
+  libglfw3-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup-debian: all ${#PACKAGES[@]} packages are installed"
+  exit 0
+fi
+
+SUDO=()
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO=(sudo); else
+    echo "setup-debian: not root and no sudo; install these packages: ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+echo "setup-debian: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${SUDO[@]}" apt-get update -q
+"${SUDO[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
