@@ -310,6 +310,27 @@ SubtractStats LbrSolid::subtract_level(std::span<const SweepRef> batch, int leve
       ws.fresh.clear();
       detail::append_polygons(ws.tree, ws.fresh);
 
+      // A difference that removes no more than the rounding of intersection points to the
+      // unit grid can account for (half a unit along the touched perimeter) is noise, e.g.
+      // a second pass along the same path: keep the old polygons, vertex for vertex.
+      {
+        double before = 0.0, after = 0.0, perimeter = 0.0;
+        for (std::uint32_t p : ws.touched) {
+          const Polygon& old = cell.polys[p];
+          before += ClipperLib::Area(old.outer.pts);
+          perimeter += detail::perimeter(old.outer.pts);
+          for (const Contour& h : old.holes) {
+            before += ClipperLib::Area(h.pts);
+            perimeter += detail::perimeter(h.pts);
+          }
+        }
+        for (const Polygon& poly : ws.fresh) {
+          after += ClipperLib::Area(poly.outer.pts);
+          for (const Contour& h : poly.holes) after += ClipperLib::Area(h.pts);
+        }
+        if (before - after <= 0.5 * perimeter) continue;
+      }
+
       // Carry the move id over to contours that came out unchanged; a new or changed
       // contour takes the latest move among the sections that overlap it.
       bool changed = ws.fresh.size() != ws.touched.size();
