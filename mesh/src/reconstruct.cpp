@@ -72,7 +72,12 @@ i128 along(const Point& a, const Point& b, const Point& x) noexcept {
   return static_cast<i128>(x.X - a.X) * (b.X - a.X) + static_cast<i128>(x.Y - a.Y) * (b.Y - a.Y);
 }
 
-enum : std::uint8_t { kLower = 1, kUpper = 2, kPinned = 4, kNarrow = 8, kWide = 16 };
+// Vertex flags at a plane: on the boundary of the level below / above (as a vertex of its
+// noded contour), an original vertex of that level (not an inserted split point), on a
+// border shared with a neighbour, on a narrow / wide cap polygon.
+enum : std::uint8_t {
+  kLower = 1, kUpper = 2, kPinned = 4, kNarrow = 8, kWide = 16, kLowerOrig = 32, kUpperOrig = 64
+};
 
 struct VInfo {
   double z = 0;
@@ -144,9 +149,6 @@ int edge_side(const geom::Rect& rr, const Point& a, const Point& b) noexcept {
   for (int sd = 0; sd < 4; ++sd)
     if (on_side(rr, sd, a) && on_side(rr, sd, b)) return sd;
   return -1;
-}
-bool on_rect(const geom::Rect& rr, const Point& p) noexcept {
-  return p.X == rr.x0 || p.X == rr.x1 || p.Y == rr.y0 || p.Y == rr.y1;
 }
 
 }  // namespace
@@ -334,6 +336,16 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
       }
   }
 
+  // Vertices on a border shared with a neighbour are decided by the border rule below,
+  // which both regions evaluate on the same data; the stock's own faces need no agreement.
+  std::array<bool, 4> has_n{};
+  for (int sd = 0; sd < 4; ++sd) has_n[sd] = neighbour(s, r, sd) >= 0;
+  auto on_shared_border = [&](const Point& x) {
+    for (int sd = 0; sd < 4; ++sd)
+      if (has_n[sd] && on_side(rr, sd, x)) return true;
+    return false;
+  };
+
   // Noded contours and the plane's vertex table.
   for (int sd = 0; sd < 2; ++sd) {
     pd.side[sd].resize(cs[sd].size());
@@ -344,10 +356,12 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
       for (std::uint32_t i = 0; i < nd.pts.size(); ++i)
         if (is_orig[sd][c][i]) nd.orig.push_back(i);
       const MoveId id = cs[sd][c]->cut_by;
-      for (const Point& x : nd.pts) {
+      for (std::uint32_t i = 0; i < nd.pts.size(); ++i) {
+        const Point& x = nd.pts[i];
         auto it = pd.verts.try_emplace(x, VInfo{zk, 0, 0}).first;
         it->second.flags |= (sd == 0 ? kLower : kUpper);
-        if (on_rect(rr, x)) it->second.flags |= kPinned;
+        if (is_orig[sd][c][i]) it->second.flags |= (sd == 0 ? kLowerOrig : kUpperOrig);
+        if (on_shared_border(x)) it->second.flags |= kPinned;
         it->second.attr = std::max(it->second.attr, id);
       }
     }
@@ -437,11 +451,91 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
   // that level's mid-plane (where the kernel sampled it). Vertices on the region border stay,
   // so that the neighbour, which decides independently, agrees on them.
   if (opt.walls == WallMode::Joined) {
+    // A corner of only one of the two levels (it may lie on an edge of the other: moving it
+    // keeps that edge's wall in its vertical plane) moves to its level's mid-plane when its
+    // step is narrow and the wall continuing it beyond that level is not vertical (the
+    // level two away has no vertex there): sharp flat-end steps and flat floors stay.
+    std::unordered_set<Point, PointHash, PointEq> below2, above1;
+    auto fill = [&](int lev, std::unordered_set<Point, PointHash, PointEq>& out) {
+      if (lev < 0 || lev >= levels) return;
+      for (const geom::Polygon& poly : s.cell(r, lev).polys) {
+        out.insert(poly.outer.pts.begin(), poly.outer.pts.end());
+        for (const geom::Contour& h : poly.holes) out.insert(h.pts.begin(), h.pts.end());
+      }
+    };
+    fill(k - 2, below2);
+    fill(k + 1, above1);
     for (auto& [x, v] : pd.verts) {
       if ((v.flags & kPinned) || !(v.flags & kNarrow) || (v.flags & kWide)) continue;
-      const std::uint8_t lu = v.flags & (kLower | kUpper);
-      if (lu == kLower) v.z = s.level_z_mm(k - 1);
-      else if (lu == kUpper) v.z = s.level_z_mm(k);
+      const std::uint8_t o = v.flags & (kLowerOrig | kUpperOrig);
+      if (o == kLowerOrig && !below2.count(x)) v.z = s.level_z_mm(k - 1);
+      else if (o == kUpperOrig && !above1.count(x)) v.z = s.level_z_mm(k);
+    }
+    // Border rule: on a shared border line, the union of both regions' levels k-1 and k is
+    // seen as intervals; a vertex where only the level-(k-1) material ends moves to that
+    // level's mid-plane when the level-k material ends within the join width along the
+    // line (a narrow step), and conversely. Corners (shared with a diagonal neighbour) stay.
+    std::vector<Coord> lo_end, up_end, lo2_end, up1_end, all_end;
+    auto ends = [&](int n, int lev, int sd, std::vector<Coord>& out) {
+      if (lev < 0 || lev >= levels) return;
+      for (const geom::Polygon& poly : s.cell(n, lev).polys) {
+        auto scan = [&](const Path& q) {
+          for (std::size_t j = 0; j < q.size(); ++j) {
+            const Point& a = q[j];
+            const Point& b = q[(j + 1) % q.size()];
+            if (on_side(rr, sd, a) && on_side(rr, sd, b)) {
+              out.push_back(line_coord(sd, a));
+              out.push_back(line_coord(sd, b));
+            }
+          }
+        };
+        scan(poly.outer.pts);
+        for (const geom::Contour& h : poly.holes) scan(h.pts);
+      }
+    };
+    auto has = [](const std::vector<Coord>& v, Coord c) { return std::binary_search(v.begin(), v.end(), c); };
+    for (int sd = 0; sd < 4; ++sd) {
+      if (!has_n[sd]) continue;
+      const int n = neighbour(s, r, sd);
+      lo_end.clear();
+      up_end.clear();
+      lo2_end.clear();
+      up1_end.clear();
+      for (int reg : {r, n}) {
+        ends(reg, k - 1, sd, lo_end);
+        ends(reg, k, sd, up_end);
+        ends(reg, k - 2, sd, lo2_end);
+        ends(reg, k + 1, sd, up1_end);
+      }
+      std::sort(lo2_end.begin(), lo2_end.end());
+      std::sort(up1_end.begin(), up1_end.end());
+      std::sort(lo_end.begin(), lo_end.end());
+      lo_end.erase(std::unique(lo_end.begin(), lo_end.end()), lo_end.end());
+      std::sort(up_end.begin(), up_end.end());
+      up_end.erase(std::unique(up_end.begin(), up_end.end()), up_end.end());
+      all_end = lo_end;
+      all_end.insert(all_end.end(), up_end.begin(), up_end.end());
+      std::sort(all_end.begin(), all_end.end());
+      all_end.erase(std::unique(all_end.begin(), all_end.end()), all_end.end());
+      // Narrow: another end of either level within the join width along the line.
+      auto near_other = [&](Coord c) {
+        auto it = std::lower_bound(all_end.begin(), all_end.end(), c);
+        double d = 1e300;
+        if (it != all_end.end() && std::next(it) != all_end.end()) d = std::min(d, static_cast<double>(*std::next(it) - c));
+        if (it != all_end.begin()) d = std::min(d, static_cast<double>(c - *std::prev(it)));
+        return d <= wjoin;
+      };
+      for (auto& [x, v] : pd.verts) {
+        if (!on_side(rr, sd, x)) continue;
+        bool corner = false;
+        for (int sd2 = 0; sd2 < 4; ++sd2)
+          if (sd2 != sd && on_side(rr, sd2, x)) corner = true;
+        if (corner) continue;
+        const Coord c = line_coord(sd, x);
+        const bool lo = has(lo_end, c), up = has(up_end, c);
+        if (lo && !up && !has(lo2_end, c) && near_other(c)) v.z = s.level_z_mm(k - 1);
+        else if (up && !lo && !has(up1_end, c) && near_other(c)) v.z = s.level_z_mm(k);
+      }
     }
   }
 }
@@ -691,12 +785,15 @@ BuildStats Reconstructor::update(const geom::LbrSolid& s) {
   for (std::uint32_t ci : s.dirty_cells()) {
     const int r = static_cast<int>(ci / static_cast<std::uint32_t>(c.levels));
     const int l = static_cast<int>(ci % static_cast<std::uint32_t>(c.levels));
-    c.plane_dirty[c.pidx(r, l)] = c.plane_dirty[c.pidx(r, l + 1)] = 1;
+    // Plane p reads levels p-2 .. p+1 of its region and of its neighbours (joined-wall
+    // decisions); walls read their two planes and the neighbours' same level.
+    const int p0 = std::max(0, l - 1), p1 = std::min(c.levels, l + 2);
     c.wall_dirty[c.widx(r, l)] = 1;
+    for (int p = p0; p <= p1; ++p) c.plane_dirty[c.pidx(r, p)] = 1;
     for (int sd = 0; sd < 4; ++sd) {
       const int n = neighbour(s, r, sd);
       if (n < 0) continue;
-      c.plane_dirty[c.pidx(n, l)] = c.plane_dirty[c.pidx(n, l + 1)] = 1;
+      for (int p = p0; p <= p1; ++p) c.plane_dirty[c.pidx(n, p)] = 1;
       c.wall_dirty[c.widx(n, l)] = 1;
     }
   }
