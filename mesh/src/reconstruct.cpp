@@ -181,6 +181,17 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
   const geom::Rect rr = s.region_rect(r);
   const double zk = plane_z(s, k);
 
+  // Vertices on a border shared with a neighbour are decided by the border rule below,
+  // which both regions evaluate on the same data; the stock's own faces need no agreement.
+  std::array<bool, 4> has_n{};
+  for (int sd = 0; sd < 4; ++sd) has_n[sd] = neighbour(s, r, sd) >= 0;
+  auto on_shared_border = [&](const Point& x) {
+    for (int sd = 0; sd < 4; ++sd)
+      if (has_n[sd] && on_side(rr, sd, x)) return true;
+    return false;
+  };
+
+
   std::array<std::vector<const geom::Contour*>, 2> cs;
   if (k > 0) contours_of(s.cell(r, k - 1), cs[0]);
   else cs[0].clear();
@@ -237,213 +248,237 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
     const i128 cr = dx * (w.Y - a.Y) - dy * (w.X - a.X);
     return cr * cr <= kNodeTol * kNodeTol * l2;
   };
+  // Edges on a shared border take only points exactly on the border: the neighbour must
+  // see the same split points, and it only knows the ones on the line.
+  auto may_insert = [&](const Point& a, const Point& b, const Point& w) {
+    if (!near_inside(a, b, w)) return false;
+    const int sd = edge_side(rr, a, b);
+    return sd < 0 || !has_n[sd] || on_side(rr, sd, w);
+  };
   struct Seg {
     Coord x0, x1, y0, y1;
     std::uint32_t side, c, j;
   };
   std::vector<Seg> segs;
   std::array<std::vector<std::vector<std::vector<Point>>>, 2> splits;
-  for (int round = 0; round < 8; ++round) {
-    segs.clear();
-    for (int sd = 0; sd < 2; ++sd) {
-      splits[sd].resize(work[sd].size());
-      for (std::uint32_t c = 0; c < work[sd].size(); ++c) {
-        const Path& p = work[sd][c];
-        splits[sd][c].assign(p.size(), {});
-        for (std::uint32_t j = 0; j < p.size(); ++j) {
-          const Point& a = p[j];
-          const Point& b = p[(j + 1) % p.size()];
-          segs.push_back({std::min(a.X, b.X), std::max(a.X, b.X), std::min(a.Y, b.Y), std::max(a.Y, b.Y),
-                          static_cast<std::uint32_t>(sd), c, j});
+  const double wjoin = opt.join_width_levels * s.level_spacing_mm() * geom::kUnitsPerMm;
+
+  // Clipper may still make a vertex of its own where two edges nearly touch (its scanbeam
+  // rounding sees them as collinear); such vertices are fed back into the noding and the
+  // plane is redone (at most 3 times; what remains is counted in `defects`).
+  std::vector<Point> extra, feed;
+  for (int attempt = 0;; ++attempt) {
+    pd.caps.clear();
+    pd.verts.clear();
+    pd.defects = pd.forced = 0;
+    feed.swap(extra);
+    extra.clear();
+    for (int round = 0; round < 8; ++round) {
+      segs.clear();
+      for (int sd = 0; sd < 2; ++sd) {
+        splits[sd].resize(work[sd].size());
+        for (std::uint32_t c = 0; c < work[sd].size(); ++c) {
+          const Path& p = work[sd][c];
+          splits[sd][c].assign(p.size(), {});
+          for (std::uint32_t j = 0; j < p.size(); ++j) {
+            const Point& a = p[j];
+            const Point& b = p[(j + 1) % p.size()];
+            segs.push_back({std::min(a.X, b.X), std::max(a.X, b.X), std::min(a.Y, b.Y), std::max(a.Y, b.Y),
+                            static_cast<std::uint32_t>(sd), c, j});
+          }
         }
       }
-    }
-    auto seg_pts = [&](const Seg& g) -> std::pair<Point, Point> {
-      const Path& p = work[g.side][g.c];
-      return {p[g.j], p[(g.j + 1) % p.size()]};
-    };
-    bool any = false;
-    if (round == 0)
-      for (const Seg& g : segs)
-        for (int sd = 0; sd < 4; ++sd) {
-          const auto [a, b] = seg_pts(g);
-          if (border[sd].empty() || !on_side(rr, sd, a) || !on_side(rr, sd, b)) continue;
-          const Coord lo = std::min(line_coord(sd, a), line_coord(sd, b));
-          const Coord hi = std::max(line_coord(sd, a), line_coord(sd, b));
-          for (auto it = std::upper_bound(border[sd].begin(), border[sd].end(), lo);
-               it != border[sd].end() && *it < hi; ++it) {
-            splits[g.side][g.c][g.j].push_back(sd < 2 ? Point{a.X, *it} : Point{*it, a.Y});
+      auto seg_pts = [&](const Seg& g) -> std::pair<Point, Point> {
+        const Path& p = work[g.side][g.c];
+        return {p[g.j], p[(g.j + 1) % p.size()]};
+      };
+      bool any = false;
+      if (round == 0)
+        for (const Seg& g : segs)
+          for (int sd = 0; sd < 4; ++sd) {
+            const auto [a, b] = seg_pts(g);
+            if (border[sd].empty() || !on_side(rr, sd, a) || !on_side(rr, sd, b)) continue;
+            const Coord lo = std::min(line_coord(sd, a), line_coord(sd, b));
+            const Coord hi = std::max(line_coord(sd, a), line_coord(sd, b));
+            for (auto it = std::upper_bound(border[sd].begin(), border[sd].end(), lo);
+                 it != border[sd].end() && *it < hi; ++it) {
+              splits[g.side][g.c][g.j].push_back(sd < 2 ? Point{a.X, *it} : Point{*it, a.Y});
+              any = true;
+            }
+          }
+      if (round == 0)
+        for (const Point& w : feed)
+          for (const Seg& g : segs) {
+            const auto [a, b] = seg_pts(g);
+            if (may_insert(a, b, w)) {
+              splits[g.side][g.c][g.j].push_back(w);
+              any = true;
+            }
+          }
+      std::sort(segs.begin(), segs.end(), [](const Seg& a, const Seg& b) { return a.x0 < b.x0; });
+      const Coord tol = static_cast<Coord>(kNodeTol);
+      for (std::size_t i = 0; i < segs.size(); ++i) {
+        const Seg& A = segs[i];
+        for (std::size_t m = i + 1; m < segs.size() && segs[m].x0 <= A.x1 + tol; ++m) {
+          const Seg& B = segs[m];
+          if (A.side == B.side || B.y0 > A.y1 + tol || A.y0 > B.y1 + tol) continue;
+          const auto [p1, p2] = seg_pts(A);
+          const auto [q1, q2] = seg_pts(B);
+          auto& sa = splits[A.side][A.c][A.j];
+          auto& sb = splits[B.side][B.c][B.j];
+          bool touch = false;
+          if (may_insert(q1, q2, p1)) { sb.push_back(p1); touch = true; }
+          if (may_insert(q1, q2, p2)) { sb.push_back(p2); touch = true; }
+          if (may_insert(p1, p2, q1)) { sa.push_back(q1); touch = true; }
+          if (may_insert(p1, p2, q2)) { sa.push_back(q2); touch = true; }
+          if (touch) {
+            any = true;
+            continue;
+          }
+          const int d1 = orient(q1, q2, p1), d2 = orient(q1, q2, p2);
+          const int d3 = orient(p1, p2, q1), d4 = orient(p1, p2, q2);
+          if (d1 * d2 < 0 && d3 * d4 < 0) {
+            const long double rx = static_cast<long double>(p2.X - p1.X), ry = static_cast<long double>(p2.Y - p1.Y);
+            const long double sx = static_cast<long double>(q2.X - q1.X), sy = static_cast<long double>(q2.Y - q1.Y);
+            const long double den = rx * sy - ry * sx;
+            const long double t =
+                (static_cast<long double>(q1.X - p1.X) * sy - static_cast<long double>(q1.Y - p1.Y) * sx) / den;
+            const Point x{static_cast<Coord>(std::llround(static_cast<double>(p1.X + t * rx))),
+                          static_cast<Coord>(std::llround(static_cast<double>(p1.Y + t * ry)))};
+            if (!same(x, p1) && !same(x, p2)) sa.push_back(x);
+            if (!same(x, q1) && !same(x, q2)) sb.push_back(x);
             any = true;
           }
         }
-    std::sort(segs.begin(), segs.end(), [](const Seg& a, const Seg& b) { return a.x0 < b.x0; });
-    const Coord tol = static_cast<Coord>(kNodeTol);
-    for (std::size_t i = 0; i < segs.size(); ++i) {
-      const Seg& A = segs[i];
-      for (std::size_t m = i + 1; m < segs.size() && segs[m].x0 <= A.x1 + tol; ++m) {
-        const Seg& B = segs[m];
-        if (A.side == B.side || B.y0 > A.y1 + tol || A.y0 > B.y1 + tol) continue;
-        const auto [p1, p2] = seg_pts(A);
-        const auto [q1, q2] = seg_pts(B);
-        auto& sa = splits[A.side][A.c][A.j];
-        auto& sb = splits[B.side][B.c][B.j];
-        bool touch = false;
-        if (near_inside(q1, q2, p1)) { sb.push_back(p1); touch = true; }
-        if (near_inside(q1, q2, p2)) { sb.push_back(p2); touch = true; }
-        if (near_inside(p1, p2, q1)) { sa.push_back(q1); touch = true; }
-        if (near_inside(p1, p2, q2)) { sa.push_back(q2); touch = true; }
-        if (touch) {
-          any = true;
-          continue;
+      }
+      if (!any) break;
+      for (int sd = 0; sd < 2; ++sd)
+        for (std::uint32_t c = 0; c < work[sd].size(); ++c) {
+          const Path& p = work[sd][c];
+          Path np;
+          std::vector<std::uint8_t> no;
+          for (std::uint32_t j = 0; j < p.size(); ++j) {
+            const Point& a = p[j];
+            const Point& b = p[(j + 1) % p.size()];
+            np.push_back(a);
+            no.push_back(is_orig[sd][c][j]);
+            auto& sp = splits[sd][c][j];
+            std::sort(sp.begin(), sp.end(), [&](const Point& u, const Point& v) { return along(a, b, u) < along(a, b, v); });
+            for (const Point& x : sp)
+              if (!same(x, a) && !same(x, b) && !same(x, np.back())) {
+                np.push_back(x);
+                no.push_back(0);
+              }
+          }
+          work[sd][c] = std::move(np);
+          is_orig[sd][c] = std::move(no);
         }
-        const int d1 = orient(q1, q2, p1), d2 = orient(q1, q2, p2);
-        const int d3 = orient(p1, p2, q1), d4 = orient(p1, p2, q2);
-        if (d1 * d2 < 0 && d3 * d4 < 0) {
-          const long double rx = static_cast<long double>(p2.X - p1.X), ry = static_cast<long double>(p2.Y - p1.Y);
-          const long double sx = static_cast<long double>(q2.X - q1.X), sy = static_cast<long double>(q2.Y - q1.Y);
-          const long double den = rx * sy - ry * sx;
-          const long double t =
-              (static_cast<long double>(q1.X - p1.X) * sy - static_cast<long double>(q1.Y - p1.Y) * sx) / den;
-          const Point x{static_cast<Coord>(std::llround(static_cast<double>(p1.X + t * rx))),
-                        static_cast<Coord>(std::llround(static_cast<double>(p1.Y + t * ry)))};
-          if (!same(x, p1) && !same(x, p2)) sa.push_back(x);
-          if (!same(x, q1) && !same(x, q2)) sb.push_back(x);
-          any = true;
+    }
+
+    // Noded contours and the plane's vertex table.
+    for (int sd = 0; sd < 2; ++sd) {
+      pd.side[sd].resize(cs[sd].size());
+      for (std::uint32_t c = 0; c < cs[sd].size(); ++c) {
+        Noded& nd = pd.side[sd][c];
+        nd.pts = work[sd][c];
+        nd.orig.clear();
+        for (std::uint32_t i = 0; i < nd.pts.size(); ++i)
+          if (is_orig[sd][c][i]) nd.orig.push_back(i);
+        const MoveId id = cs[sd][c]->cut_by;
+        for (std::uint32_t i = 0; i < nd.pts.size(); ++i) {
+          const Point& x = nd.pts[i];
+          auto it = pd.verts.try_emplace(x, VInfo{zk, 0, 0}).first;
+          it->second.flags |= (sd == 0 ? kLower : kUpper);
+          if (is_orig[sd][c][i]) it->second.flags |= (sd == 0 ? kLowerOrig : kUpperOrig);
+          if (on_shared_border(x)) it->second.flags |= kPinned;
+          it->second.attr = std::max(it->second.attr, id);
         }
       }
     }
-    if (!any) break;
+
+    // Caps: below minus above faces up, above minus below faces down.
+    std::unordered_set<EdgeKey, EdgeHash, EdgeEq> edges;
     for (int sd = 0; sd < 2; ++sd)
-      for (std::uint32_t c = 0; c < work[sd].size(); ++c) {
-        const Path& p = work[sd][c];
-        Path np;
-        std::vector<std::uint8_t> no;
-        for (std::uint32_t j = 0; j < p.size(); ++j) {
-          const Point& a = p[j];
-          const Point& b = p[(j + 1) % p.size()];
-          np.push_back(a);
-          no.push_back(is_orig[sd][c][j]);
-          auto& sp = splits[sd][c][j];
-          std::sort(sp.begin(), sp.end(), [&](const Point& u, const Point& v) { return along(a, b, u) < along(a, b, v); });
-          for (const Point& x : sp)
-            if (!same(x, a) && !same(x, b) && !same(x, np.back())) {
-              np.push_back(x);
-              no.push_back(0);
-            }
+      for (const Noded& nd : pd.side[sd])
+        for (std::size_t j = 0; j < nd.pts.size(); ++j) edges.insert(undirected(nd.pts[j], nd.pts[(j + 1) % nd.pts.size()]));
+
+    for (int dir = 0; dir < 2; ++dir) {
+      const auto& subj = pd.side[dir];
+      const auto& clip = pd.side[1 - dir];
+      if (subj.empty()) continue;
+      ClipperLib::Clipper cl;
+      cl.PreserveCollinear(true);
+      cl.StrictlySimple(false);  // strictly simple output adds vertices where output edges touch
+      for (const Noded& nd : subj) cl.AddPath(nd.pts, ClipperLib::ptSubject, true);
+      for (const Noded& nd : clip) cl.AddPath(nd.pts, ClipperLib::ptClip, true);
+      ClipperLib::PolyTree tree;
+      cl.Execute(ClipperLib::ctDifference, tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+
+      // Cap edges must be edges of the noded contours; Clipper may drop a collinear vertex,
+      // which is put back here (exactly collinear plane vertices strictly inside the edge).
+      auto fix_ring = [&](const Path& in, Path& out) {
+        out.clear();
+        for (std::size_t j = 0; j < in.size(); ++j) {
+          const Point& u = in[j];
+          const Point& v = in[(j + 1) % in.size()];
+          out.push_back(u);
+          if (edges.count(undirected(u, v))) continue;
+          std::vector<Point> mid;
+          for (const auto& [w, info] : pd.verts)
+            if (orient(u, v, w) == 0 && strictly_between(u, v, w)) mid.push_back(w);
+          std::sort(mid.begin(), mid.end(), [&](const Point& a, const Point& b) { return along(u, v, a) < along(u, v, b); });
+          Point prev = u;
+          for (const Point& w : mid) {
+            if (!edges.count(undirected(prev, w))) ++pd.defects;
+            out.push_back(w);
+            prev = w;
+          }
+          if (!edges.count(undirected(prev, v))) {
+            ++pd.defects;
+
+
+          }
         }
-        work[sd][c] = std::move(np);
-        is_orig[sd][c] = std::move(no);
-      }
-  }
+        for (const Point& x : out)
+          if (!pd.verts.count(x)) {
+            extra.push_back(x);  // made by Clipper: fed back into the noding below
+            pd.verts.emplace(x, VInfo{zk, 0, kPinned});
+          }
+      };
 
-  // Vertices on a border shared with a neighbour are decided by the border rule below,
-  // which both regions evaluate on the same data; the stock's own faces need no agreement.
-  std::array<bool, 4> has_n{};
-  for (int sd = 0; sd < 4; ++sd) has_n[sd] = neighbour(s, r, sd) >= 0;
-  auto on_shared_border = [&](const Point& x) {
-    for (int sd = 0; sd < 4; ++sd)
-      if (has_n[sd] && on_side(rr, sd, x)) return true;
-    return false;
-  };
-
-  // Noded contours and the plane's vertex table.
-  for (int sd = 0; sd < 2; ++sd) {
-    pd.side[sd].resize(cs[sd].size());
-    for (std::uint32_t c = 0; c < cs[sd].size(); ++c) {
-      Noded& nd = pd.side[sd][c];
-      nd.pts = std::move(work[sd][c]);
-      nd.orig.clear();
-      for (std::uint32_t i = 0; i < nd.pts.size(); ++i)
-        if (is_orig[sd][c][i]) nd.orig.push_back(i);
-      const MoveId id = cs[sd][c]->cut_by;
-      for (std::uint32_t i = 0; i < nd.pts.size(); ++i) {
-        const Point& x = nd.pts[i];
-        auto it = pd.verts.try_emplace(x, VInfo{zk, 0, 0}).first;
-        it->second.flags |= (sd == 0 ? kLower : kUpper);
-        if (is_orig[sd][c][i]) it->second.flags |= (sd == 0 ? kLowerOrig : kUpperOrig);
-        if (on_shared_border(x)) it->second.flags |= kPinned;
-        it->second.attr = std::max(it->second.attr, id);
+      std::vector<const ClipperLib::PolyNode*> stack;
+      for (const ClipperLib::PolyNode* c : tree.Childs) stack.push_back(c);
+      std::vector<Path> rings;
+      std::vector<const Path*> ring_ptrs;
+      while (!stack.empty()) {
+        const ClipperLib::PolyNode* outer = stack.back();
+        stack.pop_back();
+        rings.assign(1 + outer->Childs.size(), Path{});
+        fix_ring(outer->Contour, rings[0]);
+        for (std::size_t h = 0; h < outer->Childs.size(); ++h) {
+          fix_ring(outer->Childs[h]->Contour, rings[h + 1]);
+          for (const ClipperLib::PolyNode* isl : outer->Childs[h]->Childs) stack.push_back(isl);
+        }
+        const geom::Rect box = geom::bounds_of(rings[0]);
+        const bool narrow = static_cast<double>(std::min(box.x1 - box.x0, box.y1 - box.y0)) <= wjoin;
+        for (const Path& ring : rings)
+          for (const Point& x : ring) pd.verts[x].flags |= narrow ? kNarrow : kWide;
+        ring_ptrs.clear();
+        for (const Path& ring : rings) ring_ptrs.push_back(&ring);
+        tris2.clear();
+        pd.forced += triangulate(ring_ptrs, tris2, tscratch).forced;
+        for (const Triangle2& t : tris2) {
+          Tri tri{{t[0], t[1], t[2]}, {k, k, k}};
+          if (dir == 1) std::swap(tri.p[1], tri.p[2]);
+          pd.caps.push_back(tri);
+        }
       }
     }
-  }
 
-  // Caps: below minus above faces up, above minus below faces down.
-  std::unordered_set<EdgeKey, EdgeHash, EdgeEq> edges;
-  for (int sd = 0; sd < 2; ++sd)
-    for (const Noded& nd : pd.side[sd])
-      for (std::size_t j = 0; j < nd.pts.size(); ++j) edges.insert(undirected(nd.pts[j], nd.pts[(j + 1) % nd.pts.size()]));
-
-  const double wjoin = opt.join_width_levels * s.level_spacing_mm() * geom::kUnitsPerMm;
-  for (int dir = 0; dir < 2; ++dir) {
-    const auto& subj = pd.side[dir];
-    const auto& clip = pd.side[1 - dir];
-    if (subj.empty()) continue;
-    ClipperLib::Clipper cl;
-    cl.PreserveCollinear(true);
-    cl.StrictlySimple(false);  // strictly simple output adds vertices where output edges touch
-    for (const Noded& nd : subj) cl.AddPath(nd.pts, ClipperLib::ptSubject, true);
-    for (const Noded& nd : clip) cl.AddPath(nd.pts, ClipperLib::ptClip, true);
-    ClipperLib::PolyTree tree;
-    cl.Execute(ClipperLib::ctDifference, tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-
-    // Cap edges must be edges of the noded contours; Clipper may drop a collinear vertex,
-    // which is put back here (exactly collinear plane vertices strictly inside the edge).
-    auto fix_ring = [&](const Path& in, Path& out) {
-      out.clear();
-      for (std::size_t j = 0; j < in.size(); ++j) {
-        const Point& u = in[j];
-        const Point& v = in[(j + 1) % in.size()];
-        out.push_back(u);
-        if (edges.count(undirected(u, v))) continue;
-        std::vector<Point> mid;
-        for (const auto& [w, info] : pd.verts)
-          if (orient(u, v, w) == 0 && strictly_between(u, v, w)) mid.push_back(w);
-        std::sort(mid.begin(), mid.end(), [&](const Point& a, const Point& b) { return along(u, v, a) < along(u, v, b); });
-        Point prev = u;
-        for (const Point& w : mid) {
-          if (!edges.count(undirected(prev, w))) ++pd.defects;
-          out.push_back(w);
-          prev = w;
-        }
-        if (!edges.count(undirected(prev, v))) {
-          ++pd.defects;
-
-
-        }
-      }
-      for (const Point& x : out)
-        if (!pd.verts.count(x)) {
-          ++pd.defects;
-          pd.verts.emplace(x, VInfo{zk, 0, kPinned});
-        }
-    };
-
-    std::vector<const ClipperLib::PolyNode*> stack;
-    for (const ClipperLib::PolyNode* c : tree.Childs) stack.push_back(c);
-    std::vector<Path> rings;
-    std::vector<const Path*> ring_ptrs;
-    while (!stack.empty()) {
-      const ClipperLib::PolyNode* outer = stack.back();
-      stack.pop_back();
-      rings.assign(1 + outer->Childs.size(), Path{});
-      fix_ring(outer->Contour, rings[0]);
-      for (std::size_t h = 0; h < outer->Childs.size(); ++h) {
-        fix_ring(outer->Childs[h]->Contour, rings[h + 1]);
-        for (const ClipperLib::PolyNode* isl : outer->Childs[h]->Childs) stack.push_back(isl);
-      }
-      const geom::Rect box = geom::bounds_of(rings[0]);
-      const bool narrow = static_cast<double>(std::min(box.x1 - box.x0, box.y1 - box.y0)) <= wjoin;
-      for (const Path& ring : rings)
-        for (const Point& x : ring) pd.verts[x].flags |= narrow ? kNarrow : kWide;
-      ring_ptrs.clear();
-      for (const Path& ring : rings) ring_ptrs.push_back(&ring);
-      tris2.clear();
-      pd.forced += triangulate(ring_ptrs, tris2, tscratch).forced;
-      for (const Triangle2& t : tris2) {
-        Tri tri{{t[0], t[1], t[2]}, {k, k, k}};
-        if (dir == 1) std::swap(tri.p[1], tri.p[2]);
-        pd.caps.push_back(tri);
-      }
+    if (extra.empty()) break;
+    if (attempt == 3) {
+      pd.defects += extra.size();
+      break;
     }
   }
 
