@@ -197,6 +197,10 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
   else cs[0].clear();
   if (k < levels) contours_of(s.cell(r, k), cs[1]);
   else cs[1].clear();
+  // Identical levels (most levels of a part are): no crossings, no caps; only the border
+  // splits remain to be done.
+  bool identical = cs[0].size() == cs[1].size() && !cs[0].empty();
+  for (std::size_t c = 0; identical && c < cs[0].size(); ++c) identical = cs[0][c]->pts == cs[1][c]->pts;
 
   // Working copies of the two levels' contours; is_orig marks each level's own vertices.
   std::array<std::vector<Path>, 2> work;
@@ -317,7 +321,7 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
           }
       std::sort(segs.begin(), segs.end(), [](const Seg& a, const Seg& b) { return a.x0 < b.x0; });
       const Coord tol = static_cast<Coord>(kNodeTol);
-      for (std::size_t i = 0; i < segs.size(); ++i) {
+      for (std::size_t i = 0; !identical && i < segs.size(); ++i) {
         const Seg& A = segs[i];
         for (std::size_t m = i + 1; m < segs.size() && segs[m].x0 <= A.x1 + tol; ++m) {
           const Seg& B = segs[m];
@@ -402,7 +406,7 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
       for (const Noded& nd : pd.side[sd])
         for (std::size_t j = 0; j < nd.pts.size(); ++j) edges.insert(undirected(nd.pts[j], nd.pts[(j + 1) % nd.pts.size()]));
 
-    for (int dir = 0; dir < 2; ++dir) {
+    for (int dir = 0; dir < 2 && !identical; ++dir) {
       const auto& subj = pd.side[dir];
       const auto& clip = pd.side[1 - dir];
       if (subj.empty()) continue;
