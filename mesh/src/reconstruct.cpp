@@ -92,9 +92,14 @@ struct Noded {
   std::vector<std::uint32_t> orig;
 };
 
+// A triangle by exact vertex identities, with each vertex's height and attribute resolved
+// when the triangle is built (walls are rebuilt whenever one of their planes is, so these
+// stay current) so that assembly needs no vertex-table lookups.
 struct Tri {
   std::array<Point, 3> p;
   std::array<std::int32_t, 3> plane;
+  std::array<double, 3> z{};
+  std::array<MoveId, 3> attr{};
 };
 
 struct PlaneData {
@@ -577,6 +582,12 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
       }
     }
   }
+  for (Tri& t : pd.caps)
+    for (int v = 0; v < 3; ++v) {
+      const auto it = pd.verts.find(t.p[v]);
+      t.z[v] = it != pd.verts.end() ? it->second.z : zk;
+      t.attr[v] = it != pd.verts.end() ? it->second.attr : 0;
+    }
 }
 
 void Reconstructor::Cache::build_wall(const geom::LbrSolid& s, int r, int l) {
@@ -620,15 +631,24 @@ void Reconstructor::Cache::build_wall(const geom::LbrSolid& s, int r, int l) {
     for (std::uint32_t i = nd.orig[j]; i < e; ++i) out.push_back(nd.pts[i]);
     out.push_back(j + 1 < n ? nd.pts[nd.orig[j + 1]] : nd.pts[0]);
   };
+  auto resolve = [&](Tri t) {
+    for (int v = 0; v < 3; ++v) {
+      const PlaneData& pd = regions[r].planes[t.plane[v]];
+      const auto it = pd.verts.find(t.p[v]);
+      t.z[v] = it != pd.verts.end() ? it->second.z : plane_z(s, t.plane[v]);
+      t.attr[v] = it != pd.verts.end() ? it->second.attr : 0;
+    }
+    return t;
+  };
   auto strip = [&](const std::vector<Point>& B, const std::vector<Point>& T, const Point& u, const Point& v) {
     std::size_t i = 0, j = 0;
     while (i + 1 < B.size() || j + 1 < T.size()) {
       const bool adv_b = i + 1 < B.size() && (j + 1 >= T.size() || along(u, v, B[i + 1]) <= along(u, v, T[j + 1]));
       if (adv_b) {
-        wd.tris.push_back({{B[i], B[i + 1], T[j]}, {l, l, l + 1}});
+        wd.tris.push_back(resolve({{B[i], B[i + 1], T[j]}, {l, l, l + 1}}));
         ++i;
       } else {
-        wd.tris.push_back({{B[i], T[j + 1], T[j]}, {l, l + 1, l + 1}});
+        wd.tris.push_back(resolve({{B[i], T[j + 1], T[j]}, {l, l + 1, l + 1}}));
         ++j;
       }
     }
@@ -727,11 +747,8 @@ void Reconstructor::Cache::assemble(const geom::LbrSolid& s, int r) {
     std::array<std::array<double, 3>, 3> q{};
     std::array<MoveId, 3> attr{};
     for (int v = 0; v < 3; ++v) {
-      const PlaneData& pd = rc.planes[t.plane[v]];
-      auto it = pd.verts.find(t.p[v]);
-      const double z = it != pd.verts.end() ? it->second.z : plane_z(s, t.plane[v]);
-      attr[v] = it != pd.verts.end() ? it->second.attr : 0;
-      q[v] = {geom::to_mm(t.p[v].X) - ox, geom::to_mm(t.p[v].Y) - oy, z - oz};
+      attr[v] = t.attr[v];
+      q[v] = {geom::to_mm(t.p[v].X) - ox, geom::to_mm(t.p[v].Y) - oy, t.z[v] - oz};
     }
     const std::array<double, 3> e1{q[1][0] - q[0][0], q[1][1] - q[0][1], q[1][2] - q[0][2]};
     const std::array<double, 3> e2{q[2][0] - q[0][0], q[2][1] - q[0][1], q[2][2] - q[0][2]};
