@@ -76,7 +76,8 @@ class Reconstructor {
   // Rebuilds what the cells marked dirty in `solid` (since its last clear_dirty()) affect:
   // the two planes of each dirty level in its region and the neighbours' planes and walls
   // that share its borders. The result is identical to build() on the same solid. Falls
-  // back to build() when the grid changed. Does not clear the solid's dirty set.
+  // back to build() when the grid changed. Does not clear the solid's dirty set. Allocates;
+  // not for the real-time threads (run it on the render side, per DESIGN.md).
   BuildStats update(const geom::LbrSolid& solid);
 
   [[nodiscard]] int regions() const noexcept;
