@@ -60,3 +60,36 @@ TEST(MeshExport, StlAndPly) {
 }
 
 }  // namespace
+
+namespace {
+
+// GL buffers: sizes agree, normals are unit, flat floors shade flat, walls point outwards,
+// and the attribute carries the id of the move that cut there (0 on untouched stock; the
+// kernel records ids per contour, so a whole changed contour carries the id).
+TEST(MeshBuffers, NormalsAndMoveIds) {
+  geom::LbrSolid s(box_spec(20, 16, 5, 0.25, 2, 2));
+  const auto flat = cutter(geom::ToolKind::Flat, 6);
+  cut(s, flat, {-4, 4, 3}, {24, 4, 3}, 7);  // a slot in the lower regions: vertical walls, flat floor
+  const std::vector<mesh::MeshBuffers> regions = mesh::reconstruct(s);
+  std::size_t floor_vertices = 0;
+  for (const auto& m : regions) {
+    ASSERT_EQ(m.positions.size(), 3 * m.vertex_count());
+    ASSERT_EQ(m.normals.size(), 3 * m.vertex_count());
+    ASSERT_EQ(m.attributes.size(), m.vertex_count());
+    for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+      const float nx = m.normals[3 * v], ny = m.normals[3 * v + 1], nz = m.normals[3 * v + 2];
+      EXPECT_NEAR(nx * nx + ny * ny + nz * nz, 1.0f, 1e-5f);
+      const float z = m.positions[3 * v + 2], y = m.positions[3 * v + 1];
+      if (nz == 1.0f && std::abs(z - 3.0f) < 1e-4f && y > 0.9f && y < 7.1f) {
+        ++floor_vertices;  // the slot floor: flat, cut by move 7
+        EXPECT_EQ(m.attributes[v], 7.0f);
+      }
+      if (y > 8.0f) {
+        EXPECT_EQ(m.attributes[v], 0.0f);  // regions the slot does not reach
+      }
+    }
+  }
+  EXPECT_GT(floor_vertices, 0u);
+}
+
+}  // namespace

@@ -472,6 +472,17 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
         const bool narrow = static_cast<double>(std::min(box.x1 - box.x0, box.y1 - box.y0)) <= wjoin;
         for (const Path& ring : rings)
           for (const Point& x : ring) pd.verts[x].flags |= narrow ? kNarrow : kWide;
+        // Colour by time: a cap was exposed by the cuts that made its far level's contours;
+        // its vertices (also those on untouched edges) take the latest of them.
+        MoveId cap_attr = 0;
+        const std::uint8_t far_side = dir == 0 ? kUpper : kLower;
+        for (const Path& ring : rings)
+          for (const Point& x : ring) {
+            const VInfo& vi = pd.verts[x];
+            if (vi.flags & far_side) cap_attr = std::max(cap_attr, vi.attr);
+          }
+        for (const Path& ring : rings)
+          for (const Point& x : ring) pd.verts[x].attr = std::max(pd.verts[x].attr, cap_attr);
         ring_ptrs.clear();
         for (const Path& ring : rings) ring_ptrs.push_back(&ring);
         tris2.clear();
