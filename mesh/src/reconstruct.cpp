@@ -196,7 +196,6 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
     return false;
   };
 
-
   std::array<std::vector<const geom::Contour*>, 2> cs;
   if (k > 0) contours_of(s.cell(r, k - 1), cs[0]);
   else cs[0].clear();
@@ -245,8 +244,8 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
   // level within kNodeTol of an edge of the other is inserted into that edge (this absorbs
   // Clipper's rounding of intersection points, which leaves shared boundary points up to
   // ~0.7 units off each other's edges); proper crossings get a rounded intersection point
-  // inserted into both edges. Afterwards Clipper finds no crossing of its own, so the caps
-  // it returns are made of noded edges only.
+  // inserted into both edges. Afterwards the caps Clipper returns are made of noded edges
+  // (see the feedback loop below for the rare exception).
   constexpr i128 kNodeTol = 2;  // [units]
   auto near_inside = [](const Point& a, const Point& b, const Point& w) {
     if (same(w, a) || same(w, b)) return false;
