@@ -1,4 +1,4 @@
-// lbrsim — command-line entry point. Subcommands: batch, profile.
+// lbrsim — command-line entry point. Subcommands: batch, view, profile.
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -10,6 +10,8 @@
 #include "app/batch.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
+#include "app/view.hpp"
+#include "gfx/window.hpp"
 
 #ifndef LBRSIM_VERSION
 #define LBRSIM_VERSION "dev"
@@ -25,14 +27,71 @@ struct BatchOptions {
   std::vector<std::string> tools;
   double level_spacing = 0.0;
   bool quiet = false;
+  // rendering (gfx/)
+  std::string png, view = "iso", color = "plain", size = "1024x768";
+  bool view_window = false;
 };
 
-int run_batch_command(const BatchOptions& o) {
+struct ViewCliOptions {
+  bool animate = false, hidden = false, ortho = false, no_vsync = false;
+  double speed = 1.0, rate_hz = 30.0;
+  int screenshot_every = 0;
+  std::string screenshot_prefix = "lbrsim-frame-";
+  std::size_t frames = 0;
+};
+
+app::Profile batch_profile(const BatchOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
   if (!o.stock.empty()) app::apply_stock_override(profile, o.stock);
   for (const std::string& t : o.tools) app::apply_tool_override(profile, t);
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
+  return profile;
+}
+
+gfx::RenderThreadConfig render_config(const BatchOptions& o, const ViewCliOptions& v) {
+  gfx::RenderThreadConfig rc;
+  rc.rate_hz = v.rate_hz;
+  rc.vsync = !v.no_vsync;
+  rc.view = gfx::parse_view(o.view);
+  rc.ortho = v.ortho || rc.view == gfx::StandardView::Top;
+  rc.render.color = gfx::parse_color_mode(o.color);
+  gfx::parse_size(o.size, rc.width, rc.height);
+  rc.screenshot_every = v.screenshot_every;
+  rc.screenshot_prefix = v.screenshot_prefix;
+  return rc;
+}
+
+int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
+  const app::Profile profile = batch_profile(o);
+  const nc::Toolpath path = o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile);
+  app::ViewOptions vo;
+  vo.render = render_config(o, v);
+  vo.animate = v.animate;
+  vo.stream.speed = v.speed;
+  vo.hidden = v.hidden;
+  vo.frames = v.frames;
+  vo.quiet = o.quiet;
+  if (!gfx::display_available())
+    throw gfx::DisplayError("lbrsim view needs a display (DISPLAY / WAYLAND_DISPLAY are not set); "
+                            "headless: `xvfb-run -a lbrsim view --hidden ...`");
+  return app::run_view(profile, path, vo);
+}
+
+int run_batch_command(const BatchOptions& o) {
+  const app::Profile profile = batch_profile(o);
+  gfx::CaptureOptions cap;
+  if (!o.png.empty()) {
+    // Check the rendering options and the display before the (possibly long) run.
+    cap.view = gfx::parse_view(o.view);
+    cap.ortho = cap.view == gfx::StandardView::Top;
+    cap.color = gfx::parse_color_mode(o.color);
+    gfx::parse_size(o.size, cap.width, cap.height);
+    if (!gfx::display_available())
+      throw gfx::DisplayError("--png needs an X or Wayland display for its hidden OpenGL window, and neither "
+                              "DISPLAY nor WAYLAND_DISPLAY is set. Run it under a virtual X server: "
+                              "`xvfb-run -a lbrsim batch ... --png " + o.png + "`");
+  }
 
   const nc::Toolpath path = o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile);
   const std::string program = o.program.empty() ? path.source : o.program;
@@ -53,6 +112,15 @@ int run_batch_command(const BatchOptions& o) {
   app::write_mesh_files(r.solid, o.stl, o.ply);
   if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
   if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
+  if (!o.png.empty()) {
+    gfx::capture_png(r.solid, o.png, cap);
+    std::printf("wrote %s (%dx%d, view %s, colour %s)\n", o.png.c_str(), cap.width, cap.height, o.view.c_str(),
+                o.color.c_str());
+  }
+  if (o.view_window) {
+    ViewCliOptions v;
+    return run_view_command(o, v);
+  }
   return 0;
 }
 
@@ -84,6 +152,39 @@ int main(int argc, char** argv) {
   batch->add_option("--stl", b.stl, "Also write the reconstructed part as binary STL to this file");
   batch->add_option("--ply", b.ply, "Also write the reconstructed part as binary PLY (with normals, move id) to this file");
 
+  auto add_render_options = [](CLI::App* c, BatchOptions& o) {
+    c->add_option("--view", o.view, "Camera: top, front, side or iso")
+        ->check(CLI::IsMember({"top", "front", "side", "iso"}))->capture_default_str();
+    c->add_option("--color", o.color, "Colour mode: plain, heat (move of the last cut) or regions (grid)")
+        ->check(CLI::IsMember({"plain", "heat", "regions"}))->capture_default_str();
+    c->add_option("--size", o.size, "Image / window size WxH [px]")->capture_default_str();
+  };
+  batch->add_option("--png", b.png, "Render the result offscreen to this PNG (needs a display; headless: xvfb-run -a)");
+  add_render_options(batch, b);
+  batch->add_flag("--view-window", b.view_window, "Open the interactive viewer on the result");
+
+  BatchOptions vb;
+  ViewCliOptions vv;
+  CLI::App* view = cli.add_subcommand("view", "Interactive viewer: a batch result, or the program streamed in real time");
+  view->add_option("--program", vb.program, "Part program (.moves or G-code); default: the bundled demo");
+  view->add_option("--profile", vb.profile, "Machine profile (TOML)");
+  view->add_option("--stock", vb.stock, "Override the stock (as for batch)");
+  view->add_option("--tool", vb.tools, "Add or override a tool (as for batch)")->take_all();
+  view->add_option("--level-spacing", vb.level_spacing, "Level spacing Δ [mm]")->check(CLI::Range(0.001, 1000.0));
+  view->add_option("--regions", vb.regions, "Region grid NXxNY or auto");
+  view->add_flag("--quiet", vb.quiet, "Fewer messages");
+  add_render_options(view, vb);
+  view->add_flag("--animate", vv.animate, "Stream the program through the kernel in real time (geometry thread)");
+  view->add_option("--speed", vv.speed, "Simulated seconds per second when animating")->check(CLI::Range(0.01, 1000.0));
+  view->add_option("--rate", vv.rate_hz, "Render rate [Hz]")->check(CLI::Range(1.0, 240.0))->capture_default_str();
+  view->add_flag("--no-vsync", vv.no_vsync, "Do not sync buffer swaps to the display");
+  view->add_flag("--ortho", vv.ortho, "Orthographic projection");
+  view->add_flag("--hidden", vv.hidden, "No visible window (headless render thread; with --frames or --animate)");
+  view->add_option("--frames", vv.frames, "Stop after N frames");
+  view->add_option("--screenshot-every", vv.screenshot_every, "Write a PNG every N frames")->check(CLI::Range(0, 1000000));
+  view->add_option("--screenshot-prefix", vv.screenshot_prefix, "Screenshot file prefix (PREFIX000123.png)")
+      ->capture_default_str();
+
   std::string check_path;
   bool print_default = false;
   CLI::App* prof = cli.add_subcommand("profile", "Check a profile, or print the built-in default profile");
@@ -96,6 +197,7 @@ int main(int argc, char** argv) {
 
   try {
     if (batch->parsed()) return run_batch_command(b);
+    if (view->parsed()) return run_view_command(vb, vv);
     if (prof->parsed()) {
       if (print_default) {
         std::cout << app::default_profile_text();

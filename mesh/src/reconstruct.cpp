@@ -735,7 +735,9 @@ void Reconstructor::Cache::build_wall(const geom::LbrSolid& s, int r, int l) {
 void Reconstructor::Cache::assemble(const geom::LbrSolid& s, int r) {
   RegionCache& rc = regions[r];
   MeshBuffers& out = rc.out;
+  const std::uint64_t generation = out.generation;
   out = MeshBuffers{};
+  out.generation = generation + 1;
   struct AKey {
     VertexKey k;
     int cls;

@@ -50,6 +50,8 @@ struct MeshBuffers {
   double volume_mm3 = 0;               // signed volume term w.r.t. the solid's min corner [mm³]
   double join_bound_mm3 = 0;           // Σ |Δz|·projected area of moved cap triangles [mm³]
   double rounding_bound_mm3 = 0;       // volume bound of rounded edge-intersection points [mm³]
+  std::uint64_t generation = 0;        // incremented each time these buffers are reassembled
+                                       // (gfx/ uploads a region again only when it changed)
   [[nodiscard]] std::size_t triangle_count() const noexcept { return indices.size() / 3; }
   [[nodiscard]] std::size_t vertex_count() const noexcept { return keys.size(); }
 };

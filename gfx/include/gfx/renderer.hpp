@@ -1,0 +1,113 @@
+// gfx/renderer.hpp — draws the stock (per-region GPU buffers), tools, recent tool path and
+// HUD with OpenGL 3.3 core. All calls need the GL context current on the calling thread;
+// one thread at a time (the render thread, or the main thread for headless capture).
+// Allocates; never used on the real-time threads.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gfx/camera.hpp"
+#include "gfx/exchange.hpp"
+#include "gfx/mirror.hpp"
+
+namespace lbr::gfx {
+
+enum class ColorMode { Plain, Heat, Regions };
+// Parses "plain", "heat", "regions"; throws std::invalid_argument naming the choices.
+[[nodiscard]] ColorMode parse_color_mode(const std::string& s);
+[[nodiscard]] const char* to_string(ColorMode m) noexcept;
+
+struct RenderOptions {
+  ColorMode color = ColorMode::Plain;
+  bool show_tools = true;
+  bool show_path = true;
+  bool show_hud = true;
+  mesh::MeshOptions mesh;
+  int max_regions_per_frame = 16;   // upper bound of the adaptive per-frame rebuild limit
+  double mesh_budget_ms = 12.0;     // rebuild time per frame the limit adapts to [ms]
+  std::size_t path_points = 50000;  // recent tool tip points kept for display
+};
+
+// Per-frame figures (also shown in the HUD).
+struct FrameInfo {
+  StepStats step;               // regions applied / rebuilt / pending, mesh time
+  int region_limit = 0;         // the adaptive limit used this frame
+  int regions_uploaded = 0;     // region buffers sent to the GPU
+  int regions_visible = 0;      // regions inside the view frustum
+  double upload_ms = 0, draw_ms = 0;
+  std::uint64_t triangles = 0;  // stock triangles drawn
+  std::uint64_t version = 0;    // newest snapshot received
+};
+
+// Frame-pacing figures the render thread hands to the HUD.
+struct PacingInfo {
+  double rate_hz = 0;           // target rate
+  double period_ms = 0;         // last frame period
+  double frame_ms = 0;          // last frame's work (rebuild + upload + draw) [ms]
+  double p99_period_ms = 0;     // over the recent window
+  std::uint64_t late_frames = 0;
+};
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;  // rows top first, 4 bytes per pixel
+  std::vector<float> depth;        // window depth in [0, 1] per pixel, rows top first (optional)
+  [[nodiscard]] const std::uint8_t* px(int x, int y) const noexcept {
+    return &rgba[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 4];
+  }
+};
+
+class Renderer {
+ public:
+  // Needs a current OpenGL 3.3 core context. Builds the mirror's meshes (all regions) and
+  // compiles the shaders. Throws std::runtime_error with the GL log on shader errors.
+  Renderer(const geom::LbrSolid& initial, const RenderOptions& opt = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Takes a snapshot from the exchange: cells become pending in the mirror; tools, path
+  // points, counters are kept for drawing.
+  void receive(Snapshot& s);
+  // Sets the tools and path directly (batch results, tests).
+  void set_tools(std::span<const ToolState> tools);
+  void set_path(std::span<const geom::Vec3> pts);
+  void set_pacing(const PacingInfo& p) noexcept { pacing_ = p; }
+
+  // One frame into the currently bound framebuffer of w × h pixels: bounded rebuild of
+  // visible pending regions, upload of changed region buffers, draw.
+  FrameInfo frame(const Camera& cam, int w, int h);
+  // Same, into an offscreen framebuffer; returns the pixels (and depth when asked).
+  Image render_offscreen(const Camera& cam, int w, int h, bool with_depth = false, FrameInfo* info = nullptr);
+
+  [[nodiscard]] RenderOptions& options() noexcept { return opt_; }
+  [[nodiscard]] const MeshMirror& mirror() const noexcept { return mirror_; }
+  [[nodiscard]] geom::Box3 stock_box() const noexcept;
+  // Number of times region r's buffers were uploaded (tests: what a frame touched).
+  [[nodiscard]] std::uint64_t uploads(int region) const noexcept;
+
+ private:
+  struct Gl;
+  RenderOptions opt_;
+  MeshMirror mirror_;
+  std::unique_ptr<Gl> gl_;
+  std::array<ToolState, kMaxTools> tools_{};
+  int tool_count_ = 0;
+  std::deque<geom::Vec3> path_;
+  bool path_changed_ = true;
+  geom::MoveId last_move_ = 0;
+  LiveStats live_;
+  PacingInfo pacing_;
+  std::uint64_t version_ = 0;
+  int limit_ = 4;
+  FrameInfo last_;
+};
+
+// Writes RGBA rows (top first) as PNG. Throws std::runtime_error naming the path on failure.
+void write_png(const std::string& path, const Image& img);
+
+}  // namespace lbr::gfx

@@ -1,0 +1,28 @@
+// gfx/src/hud.hpp — private: the heads-up display, lines of text drawn with stb_easy_font
+// (Debian libstb-dev) over a translucent panel, in window pixels.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+namespace lbr::gfx::detail {
+
+class Hud {
+ public:
+  Hud();  // GL context current
+  ~Hud();
+  Hud(const Hud&) = delete;
+  Hud& operator=(const Hud&) = delete;
+  // Draws `text` (lines separated by '\n') at the top-left of a w × h viewport.
+  void draw(const std::string& text, int w, int h, float scale = 2.0f);
+
+ private:
+  GLuint prog_ = 0, vao_ = 0, vbo_ = 0, ebo_ = 0;
+  GLint u_screen_ = -1;
+  std::vector<char> buf_;
+  std::vector<GLuint> idx_;
+};
+
+}  // namespace lbr::gfx::detail

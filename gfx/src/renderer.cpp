@@ -1,0 +1,546 @@
+#include "gfx/renderer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include <epoxy/gl.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "gl_util.hpp"
+#include "hud.hpp"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wold-style-cast"
+#include <stb_image_write.h>
+#pragma GCC diagnostic pop
+
+namespace lbr::gfx {
+
+namespace detail {
+
+namespace {
+GLuint compile(GLenum type, const char* src, const char* name) {
+  const GLuint s = glCreateShader(type);
+  glShaderSource(s, 1, &src, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetShaderInfoLog(s, sizeof log, nullptr, log);
+    glDeleteShader(s);
+    throw std::runtime_error(std::string("gfx: shader '") + name + "' does not compile: " + log);
+  }
+  return s;
+}
+}  // namespace
+
+GLuint make_program(const char* vs, const char* fs, const char* name) {
+  const GLuint v = compile(GL_VERTEX_SHADER, vs, name), f = compile(GL_FRAGMENT_SHADER, fs, name);
+  const GLuint p = glCreateProgram();
+  glAttachShader(p, v);
+  glAttachShader(p, f);
+  glLinkProgram(p);
+  glDeleteShader(v);
+  glDeleteShader(f);
+  GLint ok = 0;
+  glGetProgramiv(p, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetProgramInfoLog(p, sizeof log, nullptr, log);
+    glDeleteProgram(p);
+    throw std::runtime_error(std::string("gfx: program '") + name + "' does not link: " + log);
+  }
+  return p;
+}
+
+}  // namespace detail
+
+namespace {
+
+const char* kMeshVs = R"(#version 330 core
+layout(location = 0) in vec3 a_pos;
+layout(location = 1) in vec3 a_nrm;
+layout(location = 2) in float a_attr;
+uniform mat4 u_vp;
+uniform mat4 u_model;
+out vec3 v_pos;
+out vec3 v_nrm;
+out float v_attr;
+void main() {
+  vec4 w = u_model * vec4(a_pos, 1.0);
+  v_pos = w.xyz;
+  v_nrm = mat3(u_model) * a_nrm;
+  v_attr = a_attr;
+  gl_Position = u_vp * w;
+})";
+
+// Modes: 0 plain, 1 heat (by move id of the last cut), 2 region colour, 3 constant colour
+// (tools), 4 unlit constant colour (path).
+const char* kMeshFs = R"(#version 330 core
+in vec3 v_pos;
+in vec3 v_nrm;
+in float v_attr;
+uniform int u_mode;
+uniform vec3 u_color;
+uniform float u_max_attr;
+uniform vec3 u_eye;
+uniform vec3 u_key;       // direction towards the key light (world)
+uniform vec3 u_stock_lo;
+uniform vec3 u_stock_hi;
+out vec4 o_col;
+vec3 heat(float t) {
+  // dark blue -> blue -> cyan -> yellow -> red (older cuts cool, recent ones hot)
+  vec3 c0 = vec3(0.10, 0.15, 0.55), c1 = vec3(0.10, 0.45, 0.95), c2 = vec3(0.15, 0.85, 0.85);
+  vec3 c3 = vec3(0.98, 0.85, 0.15), c4 = vec3(0.90, 0.15, 0.08);
+  t = clamp(t, 0.0, 1.0) * 4.0;
+  if (t < 1.0) return mix(c0, c1, t);
+  if (t < 2.0) return mix(c1, c2, t - 1.0);
+  if (t < 3.0) return mix(c2, c3, t - 2.0);
+  return mix(c3, c4, t - 3.0);
+}
+bool on_stock_face(vec3 p, vec3 n) {
+  // Untouched stock faces lie on the stock box; heat colouring leaves them plain so that
+  // cut ids interpolated over big cap triangles do not bleed onto them.
+  float e = 1e-3 * max(1.0, length(u_stock_hi - u_stock_lo));
+  return (abs(p.z - u_stock_hi.z) < e && n.z > 0.9) || (abs(p.z - u_stock_lo.z) < e && n.z < -0.9) ||
+         (abs(p.x - u_stock_lo.x) < e && n.x < -0.9) || (abs(p.x - u_stock_hi.x) < e && n.x > 0.9) ||
+         (abs(p.y - u_stock_lo.y) < e && n.y < -0.9) || (abs(p.y - u_stock_hi.y) < e && n.y > 0.9);
+}
+void main() {
+  if (u_mode == 4) { o_col = vec4(u_color, 1.0); return; }
+  vec3 n = normalize(v_nrm);
+  vec3 V = normalize(u_eye - v_pos);
+  if (dot(n, V) < 0.0) n = -n;
+  vec3 base = u_color;
+  if (u_mode == 1) {
+    base = (v_attr < 0.5 || on_stock_face(v_pos, n)) ? vec3(0.60, 0.61, 0.63) : heat(v_attr / max(u_max_attr, 1.0));
+  }
+  vec3 L = normalize(u_key);
+  vec3 F = normalize(vec3(-u_key.x, -u_key.y, 0.35));  // fill from the opposite side
+  float d = max(dot(n, L), 0.0), f = max(dot(n, F), 0.0);
+  vec3 H = normalize(L + V);
+  float s = pow(max(dot(n, H), 0.0), 48.0) * 0.35;
+  vec3 c = base * (0.28 + 0.62 * d + 0.22 * f) + vec3(s);
+  o_col = vec4(pow(c, vec3(1.0 / 1.1)), 1.0);
+})";
+
+glm::mat4 to_f(const glm::dmat4& m) { return glm::mat4(m); }
+
+// Frame on a tool: +Z of the model along the tool axis.
+glm::dmat4 tool_frame(const geom::Pose& p) {
+  glm::dvec3 a{p.axis.x, p.axis.y, p.axis.z};
+  if (glm::length(a) < 1e-9) a = {0, 0, 1};
+  a = glm::normalize(a);
+  const glm::dvec3 ref = std::abs(a.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+  const glm::dvec3 x = glm::normalize(glm::cross(ref, a)), y = glm::cross(a, x);
+  glm::dmat4 m(1.0);
+  m[0] = glm::dvec4(x, 0);
+  m[1] = glm::dvec4(y, 0);
+  m[2] = glm::dvec4(a, 0);
+  m[3] = glm::dvec4(p.tip.x, p.tip.y, p.tip.z, 1);
+  return m;
+}
+
+glm::vec3 region_color(int r) {
+  // Well-spread hues, alternating lightness so that neighbours differ.
+  const float h = std::fmod(static_cast<float>(r) * 0.61803398f, 1.0f);
+  const float l = ((r % 2) == 0) ? 0.75f : 0.55f;
+  const glm::vec3 k = glm::clamp(glm::abs(glm::mod(h * 6.0f + glm::vec3(0, 4, 2), 6.0f) - 3.0f) - 1.0f, 0.0f, 1.0f);
+  return l * (0.35f + 0.65f * k);
+}
+
+}  // namespace
+
+ColorMode parse_color_mode(const std::string& s) {
+  if (s == "plain") return ColorMode::Plain;
+  if (s == "heat") return ColorMode::Heat;
+  if (s == "regions") return ColorMode::Regions;
+  throw std::invalid_argument("unknown colour mode '" + s + "' (expected plain, heat or regions)");
+}
+
+const char* to_string(ColorMode m) noexcept {
+  switch (m) {
+    case ColorMode::Plain: return "plain";
+    case ColorMode::Heat: return "heat";
+    case ColorMode::Regions: return "regions";
+  }
+  return "?";
+}
+
+struct Renderer::Gl {
+  struct Region {
+    GLuint vao = 0, vbo[3] = {0, 0, 0}, ebo = 0;
+    GLsizei count = 0;
+    std::uint64_t generation = ~std::uint64_t{0};
+    std::uint64_t uploads = 0;
+  };
+  GLuint prog = 0;
+  GLint u_vp = -1, u_model = -1, u_mode = -1, u_color = -1, u_max_attr = -1, u_eye = -1, u_key = -1, u_lo = -1,
+        u_hi = -1;
+  std::vector<Region> regions;
+  GLuint cyl_vao = 0, cyl_vbo[3] = {0, 0, 0}, cyl_ebo = 0;
+  GLsizei cyl_count = 0;
+  GLuint path_vao = 0, path_vbo = 0;
+  GLsizei path_count = 0;
+  GLuint fbo = 0, fbo_color = 0, fbo_depth = 0;
+  int fbo_w = 0, fbo_h = 0;
+  std::unique_ptr<detail::Hud> hud;
+
+  ~Gl() {
+    for (Region& r : regions) {
+      glDeleteBuffers(3, r.vbo);
+      glDeleteBuffers(1, &r.ebo);
+      glDeleteVertexArrays(1, &r.vao);
+    }
+    glDeleteBuffers(3, cyl_vbo);
+    glDeleteBuffers(1, &cyl_ebo);
+    glDeleteVertexArrays(1, &cyl_vao);
+    glDeleteBuffers(1, &path_vbo);
+    glDeleteVertexArrays(1, &path_vao);
+    if (fbo) {
+      glDeleteFramebuffers(1, &fbo);
+      glDeleteRenderbuffers(1, &fbo_color);
+      glDeleteRenderbuffers(1, &fbo_depth);
+    }
+    glDeleteProgram(prog);
+  }
+
+  static void make_vao(GLuint& vao, GLuint* vbo, GLuint& ebo) {
+    glGenVertexArrays(1, &vao);
+    glGenBuffers(3, vbo);
+    glGenBuffers(1, &ebo);
+    glBindVertexArray(vao);
+    const GLint sizes[3] = {3, 3, 1};
+    for (GLuint a = 0; a < 3; ++a) {
+      glBindBuffer(GL_ARRAY_BUFFER, vbo[a]);
+      glEnableVertexAttribArray(a);
+      glVertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, 0, nullptr);
+    }
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ebo);
+    glBindVertexArray(0);
+  }
+
+  static void upload(GLuint vao, const GLuint* vbo, GLuint ebo, const std::vector<float>& pos, const std::vector<float>& nrm,
+                     const std::vector<float>& attr, const std::vector<std::uint32_t>& idx) {
+    glBindVertexArray(vao);
+    const std::vector<float>* src[3] = {&pos, &nrm, &attr};
+    for (int a = 0; a < 3; ++a) {
+      glBindBuffer(GL_ARRAY_BUFFER, vbo[a]);
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(src[a]->size() * sizeof(float)), src[a]->data(),
+                   GL_STATIC_DRAW);
+    }
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ebo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * sizeof(std::uint32_t)), idx.data(),
+                 GL_STATIC_DRAW);
+    glBindVertexArray(0);
+  }
+
+  void make_cylinder() {
+    // Unit cylinder r = 1, z in [0, 1], with caps; smooth side normals.
+    constexpr int n = 40;
+    std::vector<float> pos, nrm, attr;
+    std::vector<std::uint32_t> idx;
+    auto vert = [&](float x, float y, float z, float nx, float ny, float nz) {
+      pos.insert(pos.end(), {x, y, z});
+      nrm.insert(nrm.end(), {nx, ny, nz});
+      attr.push_back(0);
+      return static_cast<std::uint32_t>(attr.size() - 1);
+    };
+    for (int i = 0; i < n; ++i) {
+      const float a0 = 6.2831853f * static_cast<float>(i) / n, a1 = 6.2831853f * static_cast<float>(i + 1) / n;
+      const float c0 = std::cos(a0), s0 = std::sin(a0), c1 = std::cos(a1), s1 = std::sin(a1);
+      const auto b0 = vert(c0, s0, 0, c0, s0, 0), b1 = vert(c1, s1, 0, c1, s1, 0);
+      const auto t0 = vert(c0, s0, 1, c0, s0, 0), t1 = vert(c1, s1, 1, c1, s1, 0);
+      idx.insert(idx.end(), {b0, b1, t1, b0, t1, t0});
+      const auto bc = vert(0, 0, 0, 0, 0, -1), bb0 = vert(c0, s0, 0, 0, 0, -1), bb1 = vert(c1, s1, 0, 0, 0, -1);
+      idx.insert(idx.end(), {bc, bb1, bb0});
+      const auto tc = vert(0, 0, 1, 0, 0, 1), tt0 = vert(c0, s0, 1, 0, 0, 1), tt1 = vert(c1, s1, 1, 0, 0, 1);
+      idx.insert(idx.end(), {tc, tt0, tt1});
+    }
+    make_vao(cyl_vao, cyl_vbo, cyl_ebo);
+    upload(cyl_vao, cyl_vbo, cyl_ebo, pos, nrm, attr, idx);
+    cyl_count = static_cast<GLsizei>(idx.size());
+  }
+
+  void ensure_fbo(int w, int h) {
+    if (fbo && fbo_w == w && fbo_h == h) return;
+    if (!fbo) {
+      glGenFramebuffers(1, &fbo);
+      glGenRenderbuffers(1, &fbo_color);
+      glGenRenderbuffers(1, &fbo_depth);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, fbo_color);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+    glBindRenderbuffer(GL_RENDERBUFFER, fbo_depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, fbo_color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, fbo_depth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("gfx: offscreen framebuffer " + std::to_string(w) + "x" + std::to_string(h) +
+                               " is incomplete");
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    fbo_w = w;
+    fbo_h = h;
+  }
+};
+
+Renderer::Renderer(const geom::LbrSolid& initial, const RenderOptions& opt)
+    : opt_(opt), mirror_(initial, opt.mesh), gl_(std::make_unique<Gl>()) {
+  Gl& g = *gl_;
+  g.prog = detail::make_program(kMeshVs, kMeshFs, "mesh");
+  g.u_vp = glGetUniformLocation(g.prog, "u_vp");
+  g.u_model = glGetUniformLocation(g.prog, "u_model");
+  g.u_mode = glGetUniformLocation(g.prog, "u_mode");
+  g.u_color = glGetUniformLocation(g.prog, "u_color");
+  g.u_max_attr = glGetUniformLocation(g.prog, "u_max_attr");
+  g.u_eye = glGetUniformLocation(g.prog, "u_eye");
+  g.u_key = glGetUniformLocation(g.prog, "u_key");
+  g.u_lo = glGetUniformLocation(g.prog, "u_stock_lo");
+  g.u_hi = glGetUniformLocation(g.prog, "u_stock_hi");
+  g.regions.resize(static_cast<std::size_t>(mirror_.regions()));
+  for (Gl::Region& r : g.regions) Gl::make_vao(r.vao, r.vbo, r.ebo);
+  g.make_cylinder();
+  glGenVertexArrays(1, &g.path_vao);
+  glGenBuffers(1, &g.path_vbo);
+  glBindVertexArray(g.path_vao);
+  glBindBuffer(GL_ARRAY_BUFFER, g.path_vbo);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glVertexAttrib3f(1, 0, 0, 1);
+  glVertexAttrib1f(2, 0);
+  glBindVertexArray(0);
+  g.hud = std::make_unique<detail::Hud>();
+  limit_ = std::max(1, std::min(opt_.max_regions_per_frame, 4));
+  for (int r = 0; r < mirror_.regions(); ++r)
+    for (float a : mirror_.meshes().region(r).attributes) last_move_ = std::max(last_move_, static_cast<geom::MoveId>(a));
+}
+
+Renderer::~Renderer() = default;
+
+geom::Box3 Renderer::stock_box() const noexcept {
+  const geom::LbrSolid& s = mirror_.solid();
+  const geom::Rect r = s.stock_rect();
+  geom::Box3 b;
+  b.add({geom::to_mm(r.x0), geom::to_mm(r.y0), s.z_bottom_mm()});
+  b.add({geom::to_mm(r.x1), geom::to_mm(r.y1), s.z_top_mm()});
+  return b;
+}
+
+std::uint64_t Renderer::uploads(int region) const noexcept { return gl_->regions[static_cast<std::size_t>(region)].uploads; }
+
+void Renderer::receive(Snapshot& s) {
+  mirror_.receive(s);
+  set_tools(std::span<const ToolState>(s.tools.data(), static_cast<std::size_t>(s.tool_count)));
+  for (const geom::Vec3& p : s.path) path_.push_back(p);
+  while (path_.size() > opt_.path_points) path_.pop_front();
+  if (!s.path.empty()) path_changed_ = true;
+  s.path.clear();
+  last_move_ = std::max(last_move_, s.last_move);
+  live_ = s.stats;
+  version_ = s.version;
+}
+
+void Renderer::set_tools(std::span<const ToolState> tools) {
+  tool_count_ = static_cast<int>(std::min<std::size_t>(tools.size(), kMaxTools));
+  for (int i = 0; i < tool_count_; ++i) tools_[static_cast<std::size_t>(i)] = tools[static_cast<std::size_t>(i)];
+}
+
+void Renderer::set_path(std::span<const geom::Vec3> pts) {
+  path_.assign(pts.begin(), pts.end());
+  while (path_.size() > opt_.path_points) path_.pop_front();
+  path_changed_ = true;
+}
+
+FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
+  using clock = std::chrono::steady_clock;
+  Gl& g = *gl_;
+  FrameInfo fi;
+  fi.version = version_;
+  const double aspect = static_cast<double>(w) / std::max(h, 1);
+  const glm::dmat4 vp = cam.projection(aspect) * cam.view();
+  const Frustum fr(vp);
+  std::vector<char> vis(static_cast<std::size_t>(mirror_.regions()));
+  for (int r = 0; r < mirror_.regions(); ++r) {
+    vis[static_cast<std::size_t>(r)] = fr.intersects(mirror_.region_box(r)) ? 1 : 0;
+    fi.regions_visible += vis[static_cast<std::size_t>(r)];
+  }
+
+  // 1. Bounded rebuild of visible pending regions; the limit adapts to the time budget.
+  fi.region_limit = limit_;
+  fi.step = mirror_.step([&](int r) { return vis[static_cast<std::size_t>(r)] != 0; }, limit_);
+  if (fi.step.regions_applied > 0) {
+    if (fi.step.mesh_ms > opt_.mesh_budget_ms) limit_ = std::max(1, limit_ / 2);
+    else if (fi.step.mesh_ms < 0.5 * opt_.mesh_budget_ms && fi.step.regions_applied >= limit_)
+      limit_ = std::min(std::max(opt_.max_regions_per_frame, 1), limit_ + 1);
+  }
+
+  // 2. Upload regions whose buffers changed.
+  const auto t1 = clock::now();
+  for (int r = 0; r < mirror_.regions(); ++r) {
+    Gl::Region& gr = g.regions[static_cast<std::size_t>(r)];
+    const mesh::MeshBuffers& mb = mirror_.meshes().region(r);
+    if (gr.generation == mb.generation) continue;
+    Gl::upload(gr.vao, gr.vbo, gr.ebo, mb.positions, mb.normals, mb.attributes, mb.indices);
+    gr.count = static_cast<GLsizei>(mb.indices.size());
+    gr.generation = mb.generation;
+    ++gr.uploads;
+    ++fi.regions_uploaded;
+  }
+  if (path_changed_ && opt_.show_path) {
+    std::vector<float> pts;
+    pts.reserve(path_.size() * 3);
+    for (const geom::Vec3& p : path_) pts.insert(pts.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
+    glBindBuffer(GL_ARRAY_BUFFER, g.path_vbo);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(pts.size() * sizeof(float)), pts.data(), GL_STREAM_DRAW);
+    g.path_count = static_cast<GLsizei>(path_.size());
+    path_changed_ = false;
+  }
+  const auto t2 = clock::now();
+  fi.upload_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+
+  // 3. Draw.
+  glViewport(0, 0, w, h);
+  glClearColor(0.13f, 0.14f, 0.17f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glDisable(GL_CULL_FACE);
+  glUseProgram(g.prog);
+  const glm::mat4 vpf = to_f(vp);
+  glUniformMatrix4fv(g.u_vp, 1, GL_FALSE, glm::value_ptr(vpf));
+  const glm::mat4 ident(1.0f);
+  glUniformMatrix4fv(g.u_model, 1, GL_FALSE, glm::value_ptr(ident));
+  const glm::vec3 eye(cam.eye());
+  glUniform3fv(g.u_eye, 1, glm::value_ptr(eye));
+  // Key light from above-left of the viewer, fixed to the camera so every view is lit.
+  const glm::dvec3 fwd = glm::normalize(cam.target - cam.eye()), up = cam.up();
+  const glm::dvec3 right = glm::normalize(glm::cross(fwd, up));
+  const glm::vec3 key(glm::normalize(-fwd + 0.6 * up - 0.45 * right));
+  glUniform3fv(g.u_key, 1, glm::value_ptr(key));
+  const geom::Box3 sb = stock_box();
+  glUniform3f(g.u_lo, static_cast<float>(sb.lo.x), static_cast<float>(sb.lo.y), static_cast<float>(sb.lo.z));
+  glUniform3f(g.u_hi, static_cast<float>(sb.hi.x), static_cast<float>(sb.hi.y), static_cast<float>(sb.hi.z));
+  glUniform1f(g.u_max_attr, static_cast<float>(std::max<geom::MoveId>(last_move_, 1)));
+  const int mode = opt_.color == ColorMode::Plain ? 0 : (opt_.color == ColorMode::Heat ? 1 : 2);
+  glUniform1i(g.u_mode, mode);
+  glUniform3f(g.u_color, 0.66f, 0.68f, 0.71f);
+  for (int r = 0; r < mirror_.regions(); ++r) {
+    const Gl::Region& gr = g.regions[static_cast<std::size_t>(r)];
+    if (!vis[static_cast<std::size_t>(r)] || gr.count == 0) continue;
+    if (mode == 2) {
+      const glm::vec3 c = region_color(r);
+      glUniform3fv(g.u_color, 1, glm::value_ptr(c));
+    }
+    glBindVertexArray(gr.vao);
+    glDrawElements(GL_TRIANGLES, gr.count, GL_UNSIGNED_INT, nullptr);
+    fi.triangles += static_cast<std::uint64_t>(gr.count / 3);
+  }
+
+  if (opt_.show_tools) {
+    glUniform1i(g.u_mode, 3);
+    glBindVertexArray(g.cyl_vao);
+    for (int i = 0; i < tool_count_; ++i) {
+      const ToolState& t = tools_[static_cast<std::size_t>(i)];
+      if (t.tool == 0 || t.radius_mm <= 0) continue;
+      const glm::dmat4 f = tool_frame(t.pose);
+      struct Part {
+        double z0, z1, r;
+        glm::vec3 c;
+      };
+      const Part parts[3] = {
+          {0, t.flute_mm, t.radius_mm, {0.85f, 0.55f, 0.20f}},
+          {t.flute_mm, t.length_mm, t.radius_mm * 0.92, {0.70f, 0.71f, 0.74f}},
+          {t.length_mm, t.length_mm + t.holder_length_mm, t.holder_radius_mm, {0.30f, 0.32f, 0.36f}}};
+      for (const Part& p : parts) {
+        if (p.z1 <= p.z0 || p.r <= 0) continue;
+        const glm::dmat4 m = glm::scale(glm::translate(f, glm::dvec3(0, 0, p.z0)), glm::dvec3(p.r, p.r, p.z1 - p.z0));
+        const glm::mat4 mf = to_f(m);
+        glUniformMatrix4fv(g.u_model, 1, GL_FALSE, glm::value_ptr(mf));
+        glUniform3fv(g.u_color, 1, glm::value_ptr(p.c));
+        glDrawElements(GL_TRIANGLES, g.cyl_count, GL_UNSIGNED_INT, nullptr);
+      }
+    }
+    glUniformMatrix4fv(g.u_model, 1, GL_FALSE, glm::value_ptr(ident));
+  }
+  if (opt_.show_path && g.path_count > 1) {
+    glUniform1i(g.u_mode, 4);
+    glUniform3f(g.u_color, 1.0f, 0.85f, 0.2f);
+    glBindVertexArray(g.path_vao);
+    glDrawArrays(GL_LINE_STRIP, 0, g.path_count);
+  }
+  glBindVertexArray(0);
+
+  if (opt_.show_hud) {
+    char buf[1024];
+    const LiveStats& L = live_;
+    int n = std::snprintf(buf, sizeof buf,
+                          "frame %.1f ms  period %.1f ms (p99 %.1f)  target %.0f Hz  late %llu\n"
+                          "triangles %llu  regions rebuilt %d (applied %d, pending %d, limit %d)  mesh %.1f ms\n"
+                          "view: %s colour  version %llu  last move %u\n",
+                          pacing_.frame_ms, pacing_.period_ms, pacing_.p99_period_ms, pacing_.rate_hz,
+                          static_cast<unsigned long long>(pacing_.late_frames), static_cast<unsigned long long>(last_.triangles),
+                          last_.step.regions_rebuilt, last_.step.regions_applied, last_.step.regions_pending,
+                          last_.region_limit, last_.step.mesh_ms, to_string(opt_.color),
+                          static_cast<unsigned long long>(version_), last_move_);
+    if (n > 0 && n < static_cast<int>(sizeof buf)) {
+      if (L.live)
+        std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n),
+                      "lag %.1f ms  samples %.0f Hz  ring hw %llu/%llu  overruns %llu  decode errors %llu\n"
+                      "deadline misses %llu  %s\n",
+                      L.lag_ms, L.sample_rate_hz, static_cast<unsigned long long>(L.ring_high_water),
+                      static_cast<unsigned long long>(L.ring_capacity), static_cast<unsigned long long>(L.ring_overruns),
+                      static_cast<unsigned long long>(L.decode_errors),
+                      static_cast<unsigned long long>(L.deadline_misses), L.realtime ? "RT (SCHED_FIFO)" : "non-RT");
+      else
+        std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "no live source (batch result)\n");
+    }
+    g.hud->draw(buf, w, h);
+  }
+  fi.draw_ms = std::chrono::duration<double, std::milli>(clock::now() - t2).count();
+  last_ = fi;
+  return fi;
+}
+
+Image Renderer::render_offscreen(const Camera& cam, int w, int h, bool with_depth, FrameInfo* info) {
+  Gl& g = *gl_;
+  g.ensure_fbo(w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
+  const FrameInfo fi = frame(cam, w, h);
+  if (info) *info = fi;
+  Image img;
+  img.width = w;
+  img.height = h;
+  std::vector<std::uint8_t> raw(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, raw.data());
+  img.rgba.resize(raw.size());
+  const std::size_t row = static_cast<std::size_t>(w) * 4;
+  for (int y = 0; y < h; ++y)
+    std::copy_n(raw.data() + static_cast<std::size_t>(h - 1 - y) * row, row, img.rgba.data() + static_cast<std::size_t>(y) * row);
+  if (with_depth) {
+    std::vector<float> d(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, d.data());
+    img.depth.resize(d.size());
+    const std::size_t wr = static_cast<std::size_t>(w);
+    for (int y = 0; y < h; ++y)
+      std::copy_n(d.data() + static_cast<std::size_t>(h - 1 - y) * wr, wr, img.depth.data() + static_cast<std::size_t>(y) * wr);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return img;
+}
+
+void write_png(const std::string& path, const Image& img) {
+  if (img.width <= 0 || img.height <= 0 || img.rgba.size() != static_cast<std::size_t>(img.width) * img.height * 4)
+    throw std::runtime_error("write_png: bad image for " + path);
+  if (!stbi_write_png(path.c_str(), img.width, img.height, 4, img.rgba.data(), img.width * 4))
+    throw std::runtime_error("cannot write PNG " + path);
+}
+
+}  // namespace lbr::gfx
