@@ -214,10 +214,11 @@ std::size_t LbrSolid::dirty_count() const noexcept {
 
 void LbrSolid::clear_dirty() noexcept { std::fill(dirty_flag_.begin(), dirty_flag_.end(), std::uint8_t{0}); }
 
-void LbrSolid::set_cell(int region, int level, std::vector<Polygon> polys) {
+void LbrSolid::set_cell(int region, int level, std::vector<Polygon> polys, MoveId last_cut) {
   const std::size_t i = static_cast<std::size_t>(region) * levels_ + level;
   Cell& c = cells_[i];
   c.polys = std::move(polys);
+  c.last_cut = last_cut;
   for (Polygon& p : c.polys) p.bbox = bounds_of(p.outer.pts);
   detail::refresh_cell(c);
   ++c.version;
@@ -417,6 +418,8 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
       for (Polygon& poly : ws.fresh) ws.kept.push_back(std::move(poly));
       cell.polys.swap(ws.kept);
       detail::refresh_cell(cell);
+      cell.last_cut = 0;
+      for (std::uint32_t k : ws.selected) cell.last_cut = std::max(cell.last_cut, ws.section_id[k]);
       ++cell.version;
       dirty_flag_[ci] = 1;
       ++stats.cells_changed;
@@ -465,6 +468,7 @@ SubtractStats LbrSolid::subtract_solid(const LbrSolid& other, MoveId id) {
       }
       cell.polys.swap(ws.fresh);
       detail::refresh_cell(cell);
+      cell.last_cut = id;
       ++cell.version;
       dirty_flag_[ci] = 1;
       ++stats.cells_changed;

@@ -10,7 +10,7 @@ namespace lbr::gfx {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kPitchLimit = kPi / 2 - 1e-4;  // straight down, with a defined yaw
+constexpr double kPitchLimit = kPi / 2;  // straight down: up() stays defined by the yaw
 }  // namespace
 
 StandardView parse_view(const std::string& s) {

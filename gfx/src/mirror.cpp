@@ -50,7 +50,7 @@ StepStats MeshMirror::step(const std::function<bool(int)>& visible, int max_regi
   for (int r : chosen) {
     auto& p = pending_[static_cast<std::size_t>(r)];
     for (auto& [level, cell] : p) {
-      solid_.set_cell(r, level, std::move(cell.polys));
+      solid_.set_cell(r, level, std::move(cell.polys), cell.last_cut);
       ++st.cells_applied;
     }
     p.clear();

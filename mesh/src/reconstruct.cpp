@@ -480,6 +480,12 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
             const VInfo& vi = pd.verts[x];
             if (vi.flags & far_side) cap_attr = std::max(cap_attr, vi.attr);
           }
+        // No far-level contour (the level beyond was cut away entirely in this region): the
+        // cut that emptied that cell exposed the cap.
+        if (cap_attr == 0) {
+          const int far_level = dir == 0 ? k : k - 1;
+          if (far_level >= 0 && far_level < levels) cap_attr = s.cell(r, far_level).last_cut;
+        }
         for (const Path& ring : rings)
           for (const Point& x : ring) pd.verts[x].attr = std::max(pd.verts[x].attr, cap_attr);
         ring_ptrs.clear();

@@ -39,6 +39,8 @@ struct Cell {
   Rect bbox;                 // of all polygons; empty when the cell holds no material
   double area_units2 = 0.0;  // cached signed sum over contours [units²]
   std::uint32_t version = 0; // incremented on every change
+  MoveId last_cut = 0;       // latest move of the last change; kept when the cell becomes empty
+                             // (colour by time of a floor whose level above was cut away)
 };
 
 struct BoxStock {
@@ -162,8 +164,9 @@ class LbrSolid {
   // otherwise a description of the first violation. Slow; for tests and diagnostics.
   [[nodiscard]] std::string check_invariants() const;
 
-  // Replaces the content of one cell (used by deserialisation and tests). Marks it dirty.
-  void set_cell(int region, int level, std::vector<Polygon> polys);
+  // Replaces the content of one cell (used by deserialisation, the render-side mirror and
+  // tests). Marks it dirty.
+  void set_cell(int region, int level, std::vector<Polygon> polys, MoveId last_cut = 0);
 
  private:
   void init_cells();
