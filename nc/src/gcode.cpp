@@ -7,6 +7,7 @@
 // coordinates identically.
 #include "nc/gcode.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -390,6 +391,7 @@ class Interpreter {
     if (gw[kMotion]) {
       const int c = code10(*gw[kMotion]);
       if (c != motion_ && is_cycle(c)) cycle_sticky_ = {};
+      if (!is_cycle(c)) cycle_series_ = false;
       motion_ = c;
       if (c == 800) motion_ = -1;
     }
@@ -573,13 +575,19 @@ class Interpreter {
     if ((motion_ == 830 || motion_ == 730) && (r - bottom) / q > static_cast<double>(kMaxPecks))
       fail("'" + g + "': more than " + std::to_string(kMaxPecks) + " pecks");
 
-    double old_z = p[Z];
-    if (old_z < r) {
-      p[Z] = r;
-      b_.rapid(line_, p);
-      old_z = r;
+    // G98 retracts to the initial level: Z before this series of contiguous canned cycle
+    // blocks began (raised to R when it started below R), as LinuxCNC does.
+    if (!cycle_series_) {
+      cycle_series_ = true;
+      cycle_initial_z_ = p[Z];
+      if (p[Z] < r) {
+        p[Z] = r;
+        b_.rapid(line_, p);
+        cycle_initial_z_ = r;
+      }
     }
-    const double clear = retract_to_initial_ ? old_z : r;
+    double old_z = retract_to_initial_ ? std::max(cycle_initial_z_, r) : p[Z];
+    const double clear = retract_to_initial_ ? std::max(cycle_initial_z_, r) : r;
     double x = p[X], y = p[Y];
     const double dx = has(b, 'X') ? axis_value(b, X) : 0.0;
     const double dy = has(b, 'Y') ? axis_value(b, Y) : 0.0;
@@ -649,6 +657,8 @@ class Interpreter {
   int selected_tool_ = 0;
   int pauses_ = 0;
   CycleSticky cycle_sticky_;
+  bool cycle_series_ = false;     // inside a series of contiguous canned cycle blocks
+  double cycle_initial_z_ = 0.0;  // program Z when the series began
 };
 
 }  // namespace

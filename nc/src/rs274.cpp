@@ -95,7 +95,7 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
   AxisVector g5x = options.work_offsets[0], g92{};
   Plane plane = Plane::XY;
   double feed = 0.0;
-  bool inverse = false;
+  const bool inverse = false;  // SET_FEED_RATE is always in length units per minute
   int selected = options.start_tool;
   int line = 0;
   std::istringstream in(canon);
@@ -175,9 +175,8 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
     } else if (cmd == "SET_FEED_MODE") {
       const auto v = numbers(c.args);
       need(v, 1, cmd);
-      const long mode = std::lround(v.back());
-      if (mode != 0 && mode != 1) fail("feed per revolution (G95) is not supported");
-      inverse = mode == 1;
+      // rs274 turns inverse time (G93) into units/min rates itself; mode 1 is feed per revolution.
+      if (std::lround(v.back()) != 0) fail("feed per revolution (G95) is not supported");
     } else if (cmd == "DWELL") {
       const auto v = numbers(c.args);
       need(v, 1, cmd);
