@@ -364,6 +364,8 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"G92 X0\n", "t.ngc:1: unsupported word 'G92' (G92 offsets; use --interpreter rs274)"},
         ErrorCase{"M98 P100\n", "t.ngc:1: unsupported word 'M98' (not supported by the built-in interpreter; use --interpreter rs274)"},
         ErrorCase{"G1 X1 F100 E5\n", "t.ngc:1: unsupported word 'E5'"},
+        ErrorCase{"G1 X1 F100 D3\n", "t.ngc:1: unsupported word 'D3' (cutter radius compensation; use --interpreter rs274)"},
+        ErrorCase{"G1 F100\nG42 D3 X1\n", "t.ngc:2: unsupported word 'G42' (cutter radius compensation; use --interpreter rs274)"},
         ErrorCase{"G1 X1 F100 U5\n", "t.ngc:1: unsupported word 'U5' (axes U, V, W are not supported)"},
         ErrorCase{"(comment\nG1 X1\n", "t.ngc:1: unclosed comment '('"},
         ErrorCase{"G0 X1..2\n", "t.ngc:1: unexpected character '.'"},

@@ -162,7 +162,7 @@ class Interpreter {
         case 'M': blk.m.push_back(w); break;
         case 'N': break;  // line number: no meaning to the motion
         case 'X': case 'Y': case 'Z': case 'A': case 'B': case 'C': case 'I': case 'J': case 'K':
-        case 'R': case 'P': case 'Q': case 'L': case 'H': case 'F': case 'S': case 'T': {
+        case 'R': case 'P': case 'Q': case 'L': case 'H': case 'F': case 'S': case 'T': case 'D': {
           const int k = idx(L);
           if (blk.has[k]) fail("word '" + std::string(1, L) + "' given twice ('" + blk.text[k] + "', '" + w.text + "')");
           blk.has[k] = true;
@@ -170,7 +170,6 @@ class Interpreter {
           blk.text[k] = w.text;
           break;
         }
-        case 'D': fail("unsupported word '" + w.text + "' (cutter radius compensation" + kUseRs274 + ")");
         case 'U': case 'V': case 'W': fail("unsupported word '" + w.text + "' (axes U, V, W are not supported)");
         default: fail("unsupported word '" + w.text + "'");
       }
@@ -420,6 +419,7 @@ class Interpreter {
 
     // Every word must have been used by something in the block.
     for (char L : {'X', 'Y', 'Z', 'A', 'B', 'C', 'F', 'S', 'T'}) b.used[idx(L)] = b.used[idx(L)] || has(b, L);
+    if (has(b, 'D')) fail("unsupported word '" + text(b, 'D') + "' (cutter radius compensation" + kUseRs274 + ")");
     for (int k = 0; k < 26; ++k)
       if (b.has[k] && !b.used[k]) fail("unused word '" + b.text[k] + "' (no G-code in the block uses it)");
 
