@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -48,7 +49,7 @@ CanonLine split_canon(const std::string& s) {
   } else {
     const std::size_t n0 = i;
     while (i < n && std::isdigit(static_cast<unsigned char>(s[i]))) ++i;
-    if (i == n0) return c;
+    if (i == n0 || i - n0 > 9) return c;
     c.line = std::atoi(s.substr(n0, i - n0).c_str());
   }
   while (i < n && s[i] == ' ') ++i;
@@ -103,6 +104,8 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
   auto fail = [&](const std::string& m) { throw ParseError(name, line, "rs274: " + m); };
   auto need = [&](const std::vector<double>& v, std::size_t k, const std::string& cmd) {
     if (v.size() < k) fail("canonical command " + cmd + " has " + std::to_string(v.size()) + " numbers, expected " + std::to_string(k));
+    for (double x : v)
+      if (!std::isfinite(x) || std::abs(x) > 1e9) fail("canonical command " + cmd + " has a number out of range");
   };
   // Offsets change the program frame, not the machine position.
   auto reframe = [&](auto&& change) {
@@ -164,6 +167,7 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
       end[ax.v] = v[1] * scale;
       end[ax.w] = v[5] * scale;
       end[A] = v[6], end[B] = v[7], end[C] = v[8];
+      if (std::abs(v[4]) > 1000.0) fail("ARC_FEED with more than 1000 turns");
       const int rot = static_cast<int>(std::lround(v[4]));
       if (rot == 0) fail("ARC_FEED with rotation 0");
       if (feed <= 0.0) fail("ARC_FEED with zero feed rate");
@@ -180,6 +184,7 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
     } else if (cmd == "DWELL") {
       const auto v = numbers(c.args);
       need(v, 1, cmd);
+      if (v[0] < 0.0) fail("DWELL with a negative time");
       b.dwell(line, v[0]);
     } else if (cmd == "SELECT_TOOL") {
       const auto v = numbers(c.args);
@@ -311,8 +316,8 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
       if (!after_msg) {
         msg = l;
         after_msg = true;
-      } else if (!l.empty() && l[0] == 'N') {
-        line = std::atoi(l.c_str() + 1);
+      } else if (l.size() > 1 && l[0] == 'N' && std::isdigit(static_cast<unsigned char>(l[1]))) {
+        line = static_cast<int>(std::min(std::strtol(l.c_str() + 1, nullptr, 10), 1000000000L));
         break;
       }
     }
