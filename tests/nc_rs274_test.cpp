@@ -2,7 +2,11 @@
 // rs274 is installed — the cross-check against the built-in interpreter on real programs.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <string>
@@ -235,10 +239,16 @@ class Rs274CrossCheck : public ::testing::Test {
     if (find_rs274().empty()) GTEST_SKIP() << "rs274 (linuxcnc-uspace) is not installed";
   }
   std::string write(const std::string& name, const std::string& text) {
-    const std::string path = ::testing::TempDir() + name;
+    // Unique per process: test runs of several checkouts may share the temporary directory.
+    const std::string path = ::testing::TempDir() + "lbrsim-" + std::to_string(::getpid()) + "-" + name;
     std::ofstream(path) << text;
+    written_.push_back(path);
     return path;
   }
+  void TearDown() override {
+    for (const std::string& p : written_) std::remove(p.c_str());
+  }
+  std::vector<std::string> written_;
 };
 
 TEST_F(Rs274CrossCheck, ProgramsBothAcceptCoincideWithin1um) {
