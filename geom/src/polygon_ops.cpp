@@ -1,5 +1,7 @@
 #include "polygon_ops.hpp"
 
+#include <cmath>
+
 namespace lbr::geom {
 
 double signed_area(const Path& p) noexcept { return ClipperLib::Area(p); }
@@ -42,6 +44,13 @@ void append_polygons(const ClipperLib::PolyTree& tree, std::vector<Polygon>& out
     }
     out.push_back(std::move(poly));
   }
+}
+
+double perimeter(const Path& p) noexcept {
+  double l = 0.0;
+  for (std::size_t i = 0, j = p.size() - 1; i < p.size(); j = i++)
+    l += std::hypot(static_cast<double>(p[i].X - p[j].X), static_cast<double>(p[i].Y - p[j].Y));
+  return l;
 }
 
 void refresh_cell(Cell& cell) noexcept {

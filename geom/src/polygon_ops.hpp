@@ -13,6 +13,9 @@ namespace lbr::geom::detail {
 // Appends the polygons (outer + holes) of a Clipper PolyTree to `out`; cut_by is 0.
 void append_polygons(const ClipperLib::PolyTree& tree, std::vector<Polygon>& out);
 
+// Length of a closed contour [units].
+[[nodiscard]] double perimeter(const Path& p) noexcept;
+
 // Bounding box and cached area of a cell recomputed from its polygons.
 void refresh_cell(Cell& cell) noexcept;
 

@@ -1,0 +1,194 @@
+// Invariants of subtraction: grid independence, translation, idempotence, splitting moves,
+// monotonicity and the representation invariants, on fixed and seeded random programs.
+#include <cstdlib>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "geom/serialize.hpp"
+#include "test_util.hpp"
+
+using namespace lbr;
+using geom::ToolKind;
+
+namespace {
+
+constexpr double kTol = 0.001;
+
+struct Move {
+  int tool;
+  geom::Vec3 a, b;
+};
+
+std::vector<geom::CutterShape> shapes() {
+  return {geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol),
+          geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol),
+          geom::CutterShape::build(test::tool(ToolKind::Bull, 8, 1.5), kTol),
+          geom::CutterShape::build(test::tool(ToolKind::Drill, 5, 118), kTol)};
+}
+
+geom::LbrSolid run(const std::vector<Move>& prog, const std::vector<geom::CutterShape>& sh, int nx, int ny,
+                   geom::Vec3 shift = {}, int batch = 8) {
+  geom::LbrSolid s(test::box_spec({shift.x, shift.y, shift.z - 12}, {shift.x + 80, shift.y + 60, shift.z}, 0.2, nx, ny));
+  std::vector<geom::SweepRef> b;
+  geom::MoveId id = 1;
+  for (const Move& m : prog) {
+    b.push_back({&sh[m.tool], test::at(m.a.x + shift.x, m.a.y + shift.y, m.a.z + shift.z),
+                 test::at(m.b.x + shift.x, m.b.y + shift.y, m.b.z + shift.z), id++});
+    if (static_cast<int>(b.size()) == batch) {
+      s.subtract(b);
+      b.clear();
+    }
+  }
+  if (!b.empty()) s.subtract(b);
+  return s;
+}
+
+std::vector<Move> fixed_program() {
+  return {{0, {-10, 10, -3}, {90, 10, -3}},  {0, {90, 10, -3}, {90, 30, -3}}, {0, {90, 30, -3}, {20, 30, -3}},
+          {1, {15, 45, -1}, {70, 50, -6}},   {1, {70, 50, -6}, {70, 20, -6}}, {2, {40, 0, -8}, {40, 60, -2}},
+          {3, {60, 45, 5}, {60, 45, -11}},   {3, {25, 20, 5}, {25, 20, -9}}};
+}
+
+unsigned seed_from_env() {
+  const char* e = std::getenv("LBR_TEST_SEED");
+  return e != nullptr ? static_cast<unsigned>(std::strtoul(e, nullptr, 10)) : 20261122u;
+}
+
+std::vector<Move> random_program(unsigned seed, int n) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> x(-5, 85), y(-5, 65), z(-11, 1);
+  std::uniform_int_distribution<int> t(0, 3);
+  std::vector<Move> p;
+  geom::Vec3 at{x(rng), y(rng), z(rng)};
+  for (int i = 0; i < n; ++i) {
+    const geom::Vec3 next{x(rng), y(rng), z(rng)};
+    p.push_back({t(rng), at, next});
+    at = next;
+  }
+  return p;
+}
+
+// Upper bound on one move's swept volume: its bounding box volume.
+double box_volume(const Move& m, const geom::CutterShape& s) {
+  const double r = s.radius();
+  return (std::abs(m.b.x - m.a.x) + 2 * r) * (std::abs(m.b.y - m.a.y) + 2 * r) *
+         (std::abs(m.b.z - m.a.z) + s.height());
+}
+
+}  // namespace
+
+TEST(Invariants, SameVolumeForAnyRegionGrid) {
+  const auto sh = shapes();
+  const auto p = fixed_program();
+  const double v11 = test::removed(run(p, sh, 1, 1));
+  const double v42 = test::removed(run(p, sh, 4, 2));
+  const double v88 = test::removed(run(p, sh, 8, 8));
+  EXPECT_GT(v11, 1000.0);
+  // Only the rounding of intersection points to 0.1 µm may differ.
+  EXPECT_NEAR(v11, v42, 1e-6 * v11);
+  EXPECT_NEAR(v11, v88, 1e-6 * v11);
+}
+
+TEST(Invariants, TranslatingTheProgramTranslatesTheResult) {
+  const auto sh = shapes();
+  const auto p = fixed_program();
+  const geom::LbrSolid a = run(p, sh, 4, 4);
+  const geom::LbrSolid b = run(p, sh, 4, 4, {13.37, -7.1, 2.5});
+  EXPECT_NEAR(test::removed(a), test::removed(b), 1e-6 * test::removed(a));
+  const geom::Box3 ba = a.bounds(), bb = b.bounds();
+  EXPECT_NEAR(bb.lo.x - ba.lo.x, 13.37, 1e-4);
+  EXPECT_NEAR(bb.hi.y - ba.hi.y, -7.1, 1e-4);
+  for (int l = 0; l < a.levels(); ++l) EXPECT_NEAR(a.level_area_mm2(l), b.level_area_mm2(l), 1e-6 * 4800) << l;
+}
+
+TEST(Invariants, CuttingTheSameMoveTwiceChangesNothing) {
+  const auto sh = shapes();
+  geom::LbrSolid s(test::box_spec({0, 0, -12}, {80, 60, 0}, 0.2, 4, 4));
+  test::cut(s, sh[1], test::at(10, 10, -2), test::at(60, 40, -5), 1);
+  const double v = s.volume_mm3();
+  const std::size_t verts = s.vertex_count();
+  s.clear_dirty();
+  const geom::SubtractStats again = test::cut(s, sh[1], test::at(10, 10, -2), test::at(60, 40, -5), 2);
+  EXPECT_GT(again.cells_clipped, 0u);
+  EXPECT_NEAR(s.volume_mm3(), v, 1e-9 * v);
+  EXPECT_EQ(s.vertex_count(), verts);
+  EXPECT_EQ(again.cells_changed, 0u);
+  EXPECT_EQ(s.dirty_count(), 0u);
+}
+
+TEST(Invariants, SplittingAMoveKeepsTheVolume) {
+  const auto sh = shapes();
+  for (int tool : {0, 1}) {
+    geom::LbrSolid whole(test::box_spec({0, 0, -12}, {80, 60, 0}, 0.2, 4, 4));
+    test::cut(whole, sh[tool], test::at(5, 5, -1), test::at(75, 50, -6));
+    geom::LbrSolid split(test::box_spec({0, 0, -12}, {80, 60, 0}, 0.2, 4, 4));
+    std::vector<geom::Vec3> pts;
+    const int n = 37;
+    for (int i = 0; i <= n; ++i) {
+      const double t = static_cast<double>(i) / n;
+      pts.push_back({5 + 70 * t, 5 + 45 * t, -1 - 5 * t});
+    }
+    test::cut_path(split, sh[tool], pts, 5);
+    // Sub-move ends add polygon vertices inside the swept region only; the boundary moves
+    // by at most the chord tolerance (length 2·84 mm, depth <= 12 mm).
+    EXPECT_NEAR(test::removed(split), test::removed(whole), 2 * (2 * 84 + 2 * test::kPi * 5) * kTol * 12) << tool;
+    EXPECT_EQ(split.check_invariants(), "");
+  }
+}
+
+TEST(Invariants, SeededRandomProgram) {
+  const unsigned seed = seed_from_env();
+  std::printf("LBR_TEST_SEED=%u (set the environment variable to replay)\n", seed);
+  const auto sh = shapes();
+  const auto prog = random_program(seed, 60);
+  geom::LbrSolid s(test::box_spec({0, 0, -12}, {80, 60, 0}, 0.2, 8, 8));
+  double last = 0.0, bound = 0.0;
+  geom::MoveId id = 1;
+  for (std::size_t i = 0; i < prog.size(); i += 4) {
+    std::vector<geom::SweepRef> b;
+    for (std::size_t k = i; k < std::min(prog.size(), i + 4); ++k) {
+      b.push_back({&sh[prog[k].tool], test::at(prog[k].a.x, prog[k].a.y, prog[k].a.z),
+                   test::at(prog[k].b.x, prog[k].b.y, prog[k].b.z), id++});
+      bound += box_volume(prog[k], sh[prog[k].tool]);
+    }
+    s.subtract(b);
+    const double r = test::removed(s);
+    ASSERT_GE(r, last - 1e-9) << "removed volume decreased at move " << i << ", seed " << seed;
+    ASSERT_LE(r, bound) << "removed more than the swept volume bound, seed " << seed;
+    last = r;
+  }
+  EXPECT_GT(last, 100.0);
+  EXPECT_EQ(s.check_invariants(), "") << "seed " << seed;
+  const double v11 = test::removed(run(prog, sh, 1, 1, {}, 4));
+  EXPECT_NEAR(v11, last, 1e-6 * last) << "seed " << seed;
+}
+
+TEST(Invariants, SerialisationRoundTrip) {
+  const auto sh = shapes();
+  const geom::LbrSolid a = run(fixed_program(), sh, 3, 2);
+  const auto bytes = geom::to_bytes(a);
+  const geom::LbrSolid b = geom::from_bytes(bytes);
+  EXPECT_EQ(b.levels(), a.levels());
+  EXPECT_EQ(b.regions(), a.regions());
+  EXPECT_EQ(b.vertex_count(), a.vertex_count());
+  EXPECT_DOUBLE_EQ(b.volume_mm3(), a.volume_mm3());
+  EXPECT_EQ(geom::to_bytes(b), bytes);
+  EXPECT_EQ(b.dirty_count(), 0u);
+
+  auto bad = bytes;
+  bad[0] = 'X';
+  EXPECT_THROW(
+      {
+        try {
+          (void)geom::from_bytes(bad);
+        } catch (const std::runtime_error& e) {
+          EXPECT_STREQ(e.what(), "LBRS: at byte 1: not an LBRS file (magic \"LBRS\" expected)");
+          throw;
+        }
+      },
+      std::runtime_error);
+  bad = bytes;
+  bad.resize(bytes.size() - 5);
+  EXPECT_THROW((void)geom::from_bytes(bad), std::runtime_error);
+}

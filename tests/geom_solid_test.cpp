@@ -1,0 +1,119 @@
+// LbrSolid construction, level convention, queries, dirty set and move ids.
+#include <gtest/gtest.h>
+
+#include "test_util.hpp"
+
+using namespace lbr;
+using geom::ToolKind;
+
+TEST(Solid, BoxLevelsAndVolume) {
+  const geom::LbrSolid s(test::box_spec({0, 0, -30}, {100, 80, 0}, 0.1));
+  EXPECT_EQ(s.levels(), 300);
+  EXPECT_EQ(s.regions(), 16);
+  EXPECT_NEAR(s.volume_mm3(), 240000.0, 1e-6);
+  EXPECT_NEAR(s.level_z_mm(0), -29.95, 1e-12);
+  EXPECT_NEAR(s.level_z_mm(299), -0.05, 1e-9);
+  EXPECT_EQ(s.polygon_count(), 16u * 300u);
+  EXPECT_EQ(s.vertex_count(), 4u * 16u * 300u);
+  EXPECT_EQ(s.check_invariants(), "");
+}
+
+TEST(Solid, PartialTopSlab) {
+  // 1.05 mm at Δ = 0.1: ten full slabs and a top slab of 0.05 mm sampled at its own middle.
+  const geom::LbrSolid s(test::box_spec({0, 0, 0}, {10, 10, 1.05}, 0.1, 1, 1));
+  EXPECT_EQ(s.levels(), 11);
+  EXPECT_NEAR(s.level_thickness_mm(10), 0.05, 1e-12);
+  EXPECT_NEAR(s.level_z_mm(10), 1.025, 1e-12);
+  EXPECT_NEAR(s.volume_mm3(), 105.0, 1e-9);
+}
+
+TEST(Solid, CylinderStock) {
+  geom::SolidSpec spec;
+  spec.shape = geom::SolidSpec::Shape::Cylinder;
+  spec.cylinder = {5, -3, 40, -50, 0};
+  spec.level_spacing_mm = 0.5;
+  spec.regions_x = 3;
+  spec.regions_y = 3;
+  const geom::LbrSolid s(spec);
+  EXPECT_EQ(s.levels(), 100);
+  const double exact = test::kPi * 400.0 * 50.0;
+  EXPECT_NEAR(s.volume_mm3(), exact, 2 * test::kPi * 40.0 * spec.chord_tol_mm * 50.0);
+  EXPECT_EQ(s.check_invariants(), "");
+  const geom::Box3 b = s.bounds();
+  EXPECT_NEAR(b.lo.x, -15.0, 0.001);
+  EXPECT_NEAR(b.hi.y, 17.0, 0.001);
+}
+
+TEST(Solid, BadSpecsAreRejectedWithAReason) {
+  auto msg = [](const geom::SolidSpec& sp) {
+    try {
+      geom::LbrSolid s(sp);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(msg(test::box_spec({0, 0, 0}, {10, 10, 10}, 0.0)), "level spacing must be in [0.001, 1000] mm");
+  EXPECT_EQ(msg(test::box_spec({0, 0, 0}, {10, -10, 10}, 0.1)), "box stock needs min < max on every axis");
+  EXPECT_EQ(msg(test::box_spec({0, 0, 0}, {10, 10, 10}, 0.1, 0, 4)), "region grid must be between 1x1 and 256x256");
+  EXPECT_NE(msg(test::box_spec({0, 0, 0}, {2e6, 10, 10}, 0.1)).find("within ±107374"), std::string::npos);
+  EXPECT_NE(msg(test::box_spec({0, 0, 0}, {10, 10, 1000}, 0.001)).find("1000000 levels"), std::string::npos);
+}
+
+TEST(Solid, DirtySetAndMoveIds) {
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {40, 40, 0}, 0.5, 4, 4));  // regions 10 x 10 mm
+  s.clear_dirty();
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 4), 0.001);
+  // Slot along y = 5 from x = 2 to x = 14 at depth 2: regions 0 and 1, the top 4 levels.
+  const geom::SubtractStats st = test::cut(s, c, test::at(2, 5, -2), test::at(14, 5, -2), 7);
+  EXPECT_EQ(st.cells_changed, 8u);
+  EXPECT_EQ(s.dirty_count(), 8u);
+  for (int r = 0; r < s.regions(); ++r) {
+    for (int l = 0; l < s.levels(); ++l) {
+      const bool expect = (r == 0 || r == 1) && l >= 16;
+      EXPECT_EQ(s.is_dirty(r, l), expect) << "region " << r << " level " << l;
+      for (const geom::Polygon& p : s.cell(r, l).polys) {
+        EXPECT_EQ(p.outer.cut_by, expect ? 7u : 0u);
+      }
+    }
+  }
+  // Region 5 is untouched by a second cut elsewhere; region 0 keeps id 7 where id 9 misses it.
+  s.clear_dirty();
+  test::cut(s, c, test::at(35, 35, -1), test::at(35, 35, -1), 9);
+  EXPECT_EQ(s.cell(0, 19).polys.front().outer.cut_by, 7u);
+  // The plunge leaves a hole cut by move 9 inside region 15's untouched outline.
+  ASSERT_EQ(s.cell(15, 19).polys.front().holes.size(), 1u);
+  EXPECT_EQ(s.cell(15, 19).polys.front().holes[0].cut_by, 9u);
+  EXPECT_EQ(s.cell(15, 19).polys.front().outer.cut_by, 0u);
+  EXPECT_TRUE(s.cell(15, 17).polys.front().holes.empty());
+  EXPECT_EQ(s.dirty_count(), 2u);
+  const auto d = s.dirty_cells();
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0], 15u * 20u + 18u);
+  EXPECT_EQ(d[1], 15u * 20u + 19u);
+}
+
+TEST(Solid, BoxCullingSkipsFarCells) {
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {80, 80, 0}, 0.1, 8, 8));
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 4), 0.001);
+  const geom::SubtractStats st = test::cut(s, c, test::at(5, 5, -1), test::at(5, 5, -1));
+  // A 4 mm tool at (5, 5) touches region 0 only, in the top 10 levels.
+  EXPECT_EQ(st.cells_tested, 10u);
+  EXPECT_EQ(st.cells_clipped, 10u);
+  EXPECT_EQ(st.sections, 10u);
+}
+
+TEST(Solid, BooleanDifferenceOfTwoSolids) {
+  // Box 40 x 40 x 10 minus a cylinder Ø20 standing on z = -4 inside it: π·100·4 removed.
+  geom::LbrSolid a(test::box_spec({0, 0, -10}, {40, 40, 0}, 0.1, 2, 2));
+  geom::SolidSpec cs;
+  cs.shape = geom::SolidSpec::Shape::Cylinder;
+  cs.cylinder = {20, 20, 20, -4, 6};
+  cs.level_spacing_mm = 0.1;
+  cs.regions_x = cs.regions_y = 3;
+  const geom::LbrSolid b(cs);
+  const geom::SubtractStats st = a.subtract_solid(b, 3);
+  EXPECT_EQ(st.cells_changed, 4u * 40u);
+  EXPECT_NEAR(test::removed(a), test::kPi * 100.0 * 4.0, 2 * test::kPi * 20.0 * 0.001 * 4.0);
+  EXPECT_EQ(a.check_invariants(), "");
+}

@@ -1,0 +1,134 @@
+// Sections of sweeps: closed forms for 3-axis and tilted tools, and agreement between the
+// vertical fast path and the general support-function path.
+#include <gtest/gtest.h>
+
+#include "geom/sweep.hpp"
+#include "test_util.hpp"
+
+using namespace lbr;
+using geom::ToolKind;
+
+namespace {
+
+constexpr double kTol = 0.001;  // chord tolerance [mm]
+
+double section_area_mm2(const geom::Sweep& s, double z, std::size_t* count = nullptr) {
+  geom::Paths out;
+  geom::SectionScratch sc;
+  const std::size_t n = s.section(z, out, sc);
+  if (count != nullptr) *count = n;
+  // Union (the pieces of a rotating move may overlap) then area.
+  ClipperLib::Clipper c;
+  c.AddPaths(out, ClipperLib::ptSubject, true);
+  geom::Paths u;
+  c.Execute(ClipperLib::ctUnion, u, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  double a = 0.0;
+  for (const auto& p : u) a += ClipperLib::Area(p);
+  return geom::area_to_mm2(a);
+}
+
+}  // namespace
+
+TEST(Sweep, CircleSegmentsFollowTolerance) {
+  const int n = geom::Sweep::circle_segments(5.0, kTol);
+  // Chord band of an n-gon on radius 5 within 1 µm.
+  EXPECT_LE(5.0 * (1.0 - std::cos(test::kPi / n)), kTol);
+  EXPECT_GT(5.0 * (1.0 - std::cos(test::kPi / (n - 2))), kTol * 0.9);
+  EXPECT_EQ(geom::Sweep::circle_segments(0.0, kTol), 1);
+  EXPECT_EQ(geom::Sweep::circle_segments(1e-6, kTol), 8);
+}
+
+TEST(Sweep, HorizontalFlatMoveIsAStadium) {
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
+  const geom::Sweep s(shape, test::at(0, 0, 0), test::at(20, 0, 0));
+  EXPECT_TRUE(s.vertical());
+  EXPECT_DOUBLE_EQ(s.z_min(), 0.0);
+  EXPECT_DOUBLE_EQ(s.z_max(), 30.0);
+  std::size_t n = 0;
+  const double a = section_area_mm2(s, 1.0, &n);
+  EXPECT_EQ(n, 1u);
+  const double exact = 2 * 5.0 * 20.0 + test::kPi * 25.0;
+  const double perimeter = 40.0 + 2 * test::kPi * 5.0;
+  EXPECT_NEAR(a, exact, perimeter * kTol);
+  EXPECT_EQ(section_area_mm2(s, -0.01), 0.0);  // below the tip
+  EXPECT_EQ(section_area_mm2(s, 30.01), 0.0);  // above the flutes
+}
+
+TEST(Sweep, BallPlungeSectionIsTheWidestDisk) {
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  const geom::Sweep s(shape, test::at(0, 0, 10), test::at(0, 0, 0));
+  // At z = 1 the widest disk is at h = 1: r² = 9 - 4 = 5.
+  EXPECT_NEAR(section_area_mm2(s, 1.0), test::kPi * 5.0, 2 * test::kPi * std::sqrt(5.0) * 2 * kTol);
+}
+
+TEST(Sweep, TiltedFlatToolGivesTheEllipse) {
+  const double th = 30.0 * test::kPi / 180.0;
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
+  const geom::Vec3 ax{std::sin(th), 0, std::cos(th)};
+  const geom::Sweep s(shape, test::at(0, 0, 0, ax), test::at(0, 0, 0, ax));
+  EXPECT_FALSE(s.vertical());
+  EXPECT_NEAR(s.z_min(), -5.0 * std::sin(th), 1e-9);
+  const double a = section_area_mm2(s, 5.0);
+  const double exact = test::kPi * 25.0 / std::cos(th);
+  EXPECT_NEAR(a, exact, 2 * test::kPi * 5.8 * kTol);
+}
+
+TEST(Sweep, AxisParallelToTheLevelPlane) {
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
+  const geom::Sweep s(shape, test::at(0, 0, 0, {1, 0, 0}), test::at(0, 0, 0, {1, 0, 0}));
+  // A cylinder of radius 5 along X from 0 to 30, cut by z = 3: a 30 x 8 rectangle.
+  EXPECT_NEAR(section_area_mm2(s, 3.0), 30.0 * 8.0, 80.0 * kTol);
+  EXPECT_NEAR(section_area_mm2(s, 0.0), 30.0 * 10.0, 80.0 * kTol);
+  EXPECT_EQ(section_area_mm2(s, 5.01), 0.0);
+}
+
+TEST(Sweep, GeneralPathAgreesWithVerticalFastPath) {
+  // A ramped ball move and a bull-nose ramp: the fast path (axis exactly +Z) and the general
+  // path (axis tilted by 1e-9 rad) must give the same sections within the chord tolerance.
+  for (const auto& t : {test::tool(ToolKind::Ball, 6), test::tool(ToolKind::Bull, 12, 2), test::tool(ToolKind::Drill, 8, 118)}) {
+    const auto shape = geom::CutterShape::build(t, kTol);
+    const geom::Vec3 almost{1e-9, 0, 1};
+    const geom::Sweep fast(shape, test::at(0, 0, 2), test::at(10, 4, 0));
+    const geom::Sweep gen(shape, test::at(0, 0, 2, almost), test::at(10, 4, 0, almost));
+    ASSERT_TRUE(fast.vertical());
+    ASSERT_FALSE(gen.vertical());
+    for (double z : {0.05, 0.5, 1.0, 1.7, 2.5, 4.0}) {
+      const double af = section_area_mm2(fast, z), ag = section_area_mm2(gen, z);
+      EXPECT_GT(af, 0.0);
+      EXPECT_NEAR(af, ag, 2 * (2 * 10.8 + 2 * test::kPi * 6) * kTol) << geom::to_string(t.kind) << " z " << z;
+    }
+  }
+}
+
+TEST(Sweep, RotatingAxisIsSubdividedAndCoversBothEnds) {
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
+  const double th = 20.0 * test::kPi / 180.0;
+  const geom::Sweep rot(shape, test::at(0, 0, 0, {0, 0, 1}), test::at(0, 0, 0, {std::sin(th), 0, std::cos(th)}));
+  const geom::Sweep start(shape, test::at(0, 0, 0, {1e-12, 0, 1}), test::at(0, 0, 0, {1e-12, 0, 1}));
+  const geom::Sweep end(shape, test::at(0, 0, 0, {std::sin(th), 0, std::cos(th)}),
+                        test::at(0, 0, 0, {std::sin(th), 0, std::cos(th)}));
+  // The rotating sweep contains both end poses' sections, and is larger than either.
+  const double z = 8.0;
+  const double ar = section_area_mm2(rot, z), as = section_area_mm2(start, z), ae = section_area_mm2(end, z);
+  EXPECT_GT(ar, as + 1.0);
+  EXPECT_GT(ar, ae + 1.0);
+  // Bounded by the hull of the two ellipses' extents: x from -5 to 8 tan(20°) + 5/cos(20°).
+  EXPECT_LT(ar, (8.0 * std::tan(th) + 5.0 / std::cos(th) + 5.0) * 10.0);
+}
+
+TEST(Sweep, StadiumFastPathAgreesWithGeneralPathInAnyDirection) {
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  const geom::Vec3 almost{0, 1e-9, 1};
+  for (double deg : {0.0, 17.0, 45.0, 90.0, 133.3, 180.0, 271.0}) {
+    const double a = deg * test::kPi / 180.0;
+    const geom::Vec3 e{7.0 * std::cos(a), 7.0 * std::sin(a), 0.0};
+    const geom::Sweep fast(shape, test::at(0, 0, 0), test::at(e.x, e.y, 0));
+    const geom::Sweep gen(shape, test::at(0, 0, 0, almost), test::at(e.x, e.y, 0, almost));
+    for (double z : {0.5, 2.0, 4.0}) {
+      const double r = shape.radius_at(z);
+      const double exact = 2 * r * 7.0 + test::kPi * r * r;
+      EXPECT_NEAR(section_area_mm2(fast, z), exact, 2 * (14.0 + 2 * test::kPi * r) * kTol) << deg << " " << z;
+      EXPECT_NEAR(section_area_mm2(gen, z), exact, 2 * (14.0 + 2 * test::kPi * r) * kTol) << deg << " " << z;
+    }
+  }
+}
