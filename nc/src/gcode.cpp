@@ -338,7 +338,7 @@ class Interpreter {
     if (m6 != nullptr) b_.tool_change(line_, selected_tool_);
     // 5. spindle, coolant
     if (mspindle != nullptr) spindle_ = static_cast<int>(mspindle->value);
-    (void)mcool;
+    if (mcool != nullptr) coolant_ = static_cast<int>(mcool->value);
     // 6. dwell
     if (dwell != 0) {
       if (!has(b, 'P')) fail("'G4' needs P (dwell time [s])");
@@ -406,13 +406,13 @@ class Interpreter {
       if (c != 0 && c != 10) fail("'G53' needs G0 or G1 in the block or in effect");
       if (!absolute_) fail("'G53' needs absolute distance mode (G90)");
       const AxisVector t = target(b, true);
-      move_line(b, c, t, f_in_block);
+      move_line(c, t, f_in_block);
     } else if (any_axis(b) || (gw[kMotion] != nullptr && (is_cycle(motion_) || motion_ == 20 || motion_ == 30))) {
       if (motion_ < 0) {
         for (char L : kAxisLetters)
           if (has(b, L)) fail("axis word '" + text(b, L) + "' given but no motion mode is in effect");
       }
-      if (motion_ == 0 || motion_ == 10) move_line(b, motion_, target(b, false), f_in_block);
+      if (motion_ == 0 || motion_ == 10) move_line(motion_, target(b, false), f_in_block);
       else if (motion_ == 20 || motion_ == 30) move_arc(b, f_in_block);
       else if (motion_ >= 0) canned_cycle(b);
     }
@@ -468,22 +468,21 @@ class Interpreter {
     b_.rapid(line_, b_.from_machine(m));
   }
 
-  double feed_for_move(Block& b, const std::string& g, bool f_in_block) {
+  double feed_for_move(const std::string& g, bool f_in_block) const {
     if (inverse_time_) {
       if (!f_in_block) fail("'" + g + "' in inverse time mode (G93) needs an F word in the block");
       if (feed_ <= 0.0) fail("'" + g + "' in inverse time mode (G93) needs F > 0");
       return feed_;
     }
-    (void)b;
     if (feed_ <= 0.0) fail("'" + g + "' needs a feed rate: no F word > 0 given yet");
     return feed_ * scale_;
   }
 
-  void move_line(Block& b, int c, const AxisVector& t, bool f_in_block) {
+  void move_line(int c, const AxisVector& t, bool f_in_block) {
     if (c == 0) {
       b_.rapid(line_, t);
     } else {
-      const double f = feed_for_move(b, "G1", f_in_block);
+      const double f = feed_for_move("G1", f_in_block);
       b_.feed(line_, t, f, inverse_time_);
     }
   }
@@ -500,7 +499,7 @@ class Interpreter {
     if (!ijk && !r_form) fail("'" + g + "' needs R or a centre word " + cu_l + "/" + cv_l + " (plane " + plane_name + ")");
     int turns = 1;
     if (has(b, 'P')) turns = integer(b, 'P', 1, 1000);
-    const double f = feed_for_move(b, g, f_in_block);
+    const double f = feed_for_move(g, f_in_block);
     const AxisVector start = b_.position();
     const AxisVector end = target(b, false);
     const double du = end[ax.u] - start[ax.u], dv = end[ax.v] - start[ax.v];
@@ -563,7 +562,7 @@ class Interpreter {
     if (!cs.has_r || !cs.has_z) fail("canned cycle '" + g + "' needs R and Z");
     if ((motion_ == 830 || motion_ == 730) && (!cs.has_q || cs.q <= 0.0)) fail("'" + g + "' needs Q > 0 (peck depth)");
     if (motion_ == 820 && (!cs.has_p || cs.p < 0.0)) fail("'G82' needs P >= 0 (dwell time [s])");
-    const double f = feed_for_move(b, g, has(b, 'F'));
+    const double f = feed_for_move(g, has(b, 'F'));
     int repeats = 1;
     if (has(b, 'L')) repeats = integer(b, 'L', 0, static_cast<int>(kMaxRepeats));
 
@@ -653,7 +652,8 @@ class Interpreter {
   int motion_ = -1;  // code x 10; -1: none (G80 or program start)
   double feed_ = 0.0;
   double spindle_rpm_ = 0.0;
-  int spindle_ = 5;
+  int spindle_ = 5;  // M3, M4 or M5 (recorded, not in the Toolpath)
+  int coolant_ = 9;  // M7, M8 or M9 (recorded, not in the Toolpath)
   int selected_tool_ = 0;
   int pauses_ = 0;
   CycleSticky cycle_sticky_;
