@@ -101,6 +101,13 @@ TEST(Emulator, AxisLimitsScaleThePathSpeed) {
   EXPECT_NEAR(em.total_time_s(), L / p.v + p.v / p.a, 1e-12);
 }
 
+TEST(Emulator, RotaryOnlyMoveUsesDegreesPerMinute) {
+  Toolpath tp = line_path(0, 3600);  // F3600 read as deg/min
+  tp.segments[0].end = {0, 0, 0, 90, 0, 0};
+  // A limits: 3600 deg/min = 60 deg/s, 720 deg/s²: t = 90/60 + 60/720.
+  EXPECT_NEAR(emulated_time_s(tp, limits()), 1.5 + 60.0 / 720.0, 1e-12);
+}
+
 TEST(Emulator, DwellToolChangeAndRapidTimes) {
   Toolpath tp;
   Segment tc;

@@ -402,6 +402,29 @@ TEST(GcodeErrors, ArcChordLimitIsAnErrorNotAHang) {
             "t.ngc:2: arc of radius 100000 mm needs more than 1000000 chords at the chord tolerance 1e-06 mm");
 }
 
+// Metamorphic: the same program run in G55 shifted by (dx, dy, dz), or written incrementally,
+// gives the same path shifted / the same path.
+TEST(GcodeMetamorphic, WorkOffsetShiftsAndIncrementalFormAgree) {
+  const std::string body =
+      "G0 X10 Y0 Z5\nG1 Z-1 F300\nG3 X0 Y10 I-10 J0\nG2 X-10 Y0 R10\nG18 G2 X0 Z-1 I5 K0\nG17\n"
+      "G98 G81 X20 Y20 Z-4 R2\nG80\nG0 Z10\n";
+  const Toolpath base = run(body);
+  const Toolpath shifted = run("G10 L2 P2 X7 Y-3 Z2\nG55\n" + body);
+  ASSERT_EQ(base.segments.size(), shifted.segments.size());
+  for (std::size_t i = 0; i < base.segments.size(); ++i) {
+    SCOPED_TRACE(i);
+    expect_at(shifted.segments[i], base.segments[i].end[X] + 7, base.segments[i].end[Y] - 3, base.segments[i].end[Z] + 2);
+  }
+  const Toolpath incremental =
+      run("G91 G0 X10 Y0 Z5\nG1 Z-6 F300\nG3 X-10 Y10 I-10 J0\nG2 X-10 Y-10 R10\nG18 G2 X10 Z0 I5 K0\nG90 G17\n"
+          "G98 G81 X20 Y20 Z-4 R2\nG80\nG0 Z10\n");
+  ASSERT_EQ(base.segments.size(), incremental.segments.size());
+  for (std::size_t i = 0; i < base.segments.size(); ++i) {
+    SCOPED_TRACE(i);
+    expect_at(incremental.segments[i], base.segments[i].end[X], base.segments[i].end[Y], base.segments[i].end[Z]);
+  }
+}
+
 TEST(GcodeFile, BundledCamProgramInterprets) {
   GcodeOptions o;
   o.tool_lengths = {{1, 60}, {2, 50}, {3, 70}};
