@@ -36,6 +36,7 @@ TEST(MachineProfile, EmulatorKeysReachTheLimits) {
   EXPECT_DOUBLE_EQ(l.sample_period_ms, 2);
   const nc::GcodeOptions o = app::gcode_options(p);
   EXPECT_DOUBLE_EQ(o.tool_lengths.at(7), 42);
+  EXPECT_DOUBLE_EQ(o.tool_diameters.at(7), 6);
   EXPECT_DOUBLE_EQ(o.work_offsets[0][nc::X], -300);
   EXPECT_DOUBLE_EQ(o.work_offsets[0][nc::Z], -400);
   EXPECT_DOUBLE_EQ(o.chord_tol_mm, p.solid.chord_tol_mm);

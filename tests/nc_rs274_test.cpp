@@ -304,6 +304,21 @@ TEST_F(Rs274CrossCheck, AcceptsWhatTheBuiltInRejects) {
   EXPECT_NEAR(tp.segments[2].end[Y], 8.0, 1e-9);
 }
 
+TEST_F(Rs274CrossCheck, CutterCompensationUsesTheProfileDiameters) {
+  const std::string path = write("comp.ngc",
+                                 "G21 G90 G17\nT1 M6\nG43 H1 G0 X-10 Y-10 Z5\nG1 Z-1 F300\nG41 G1 X0 Y0 D1\n"
+                                 "G1 X20\nG1 Y20\nG1 X0\nG1 Y0\nG40 G1 X-10 Y-10\nM2\n");
+  GcodeOptions o = recorded_options(0.001);
+  o.tool_diameters = {{1, 10.0}};
+  const Toolpath tp = run_rs274(path, o);
+  // Left compensation on a counter-clockwise square: the centre runs 5 mm inside it.
+  double xmax = -1e9, ymax = -1e9;
+  for (const Segment& s : tp.segments)
+    if (s.end[Z] < 0 && s.line >= 6 && s.line <= 9) xmax = std::max(xmax, s.end[X]), ymax = std::max(ymax, s.end[Y]);
+  EXPECT_NEAR(xmax, 15.0, 1e-4);
+  EXPECT_NEAR(ymax, 15.0, 1e-4);
+}
+
 TEST_F(Rs274CrossCheck, ErrorsNameTheSourceLine) {
   const std::string path = write("bad.ngc", "G21 G90\nG0 X0 Y0\nG2 X10 Y0 I4 F100\nM2\n");
   try {

@@ -279,7 +279,10 @@ Profile default_profile() { return parse_profile(kDefaultProfileToml, "<built-in
 nc::GcodeOptions gcode_options(const Profile& p) {
   nc::GcodeOptions o;
   o.machine = nc::MachineKind::Mill3;  // the only kind profiles accept so far
-  for (const auto& [n, t] : p.tools) o.tool_lengths[n] = t.length_mm;
+  for (const auto& [n, t] : p.tools) {
+    o.tool_lengths[n] = t.length_mm;
+    o.tool_diameters[n] = t.diameter_mm;
+  }
   o.chord_tol_mm = p.solid.chord_tol_mm;
   for (int a = 0; a < 3; ++a) o.work_offsets[0][a] = p.g54_origin_mm[static_cast<std::size_t>(a)];
   return o;

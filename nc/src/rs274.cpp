@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <vector>
 
@@ -278,9 +279,12 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
   std::ostringstream tbl;
   tbl.precision(12);
   int pocket = 1;
-  for (const auto& [t, len] : options.tool_lengths) {
+  std::map<int, std::pair<double, double>> tools;  // number -> (length, diameter) [mm]
+  for (const auto& [t, len] : options.tool_lengths) tools[t].first = len;
+  for (const auto& [t, d] : options.tool_diameters) tools[t].second = d;
+  for (const auto& [t, ld] : tools) {
     if (t <= 0) continue;
-    tbl << 'T' << t << " P" << pocket++ << " Z" << std::fixed << len / kInch << " ;\n";
+    tbl << 'T' << t << " P" << pocket++ << std::fixed << " Z" << ld.first / kInch << " D" << ld.second / kInch << " ;\n";
   }
   write("tool.tbl", tbl.str());
   std::ostringstream var;

@@ -31,7 +31,9 @@ enum class MachineKind : unsigned char {
 
 struct GcodeOptions {
   MachineKind machine = MachineKind::Mill3;
-  std::map<int, double> tool_lengths;  // tool number -> gauge line to tip [mm]; missing = 0
+  std::map<int, double> tool_lengths;    // tool number -> gauge line to tip [mm]; missing = 0
+  std::map<int, double> tool_diameters;  // tool number -> diameter [mm]; used by rs274's cutter
+                                         // compensation (the built-in interpreter rejects G41/G42)
   double chord_tol_mm = 0.001;         // max distance of an arc chord from the arc [mm]
   // Machine coordinates of the G54, G55, ... G59, G59.1, G59.2, G59.3 origins [mm, deg]
   // at program start (G10 L2 changes them while the program runs). work_offsets[0] defines
