@@ -11,6 +11,9 @@ PACKAGES=(
   libglfw3-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
+  # LinuxCNC's rs274 interpreter: optional at run time (lbrsim --interpreter rs274), needed for
+  # the rs274 cross-check tests (they skip without it)
+  linuxcnc-uspace
 )
 
 missing=()

@@ -1,5 +1,7 @@
 #include "app/batch.hpp"
 
+#include "app/level_pool.hpp"
+
 #include <sys/resource.h>
 
 #include <chrono>
@@ -41,7 +43,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
   std::map<int, geom::CutterShape> shapes;
   for (const nc::Segment& s : path.segments) {
     if (s.kind != nc::SegmentKind::Rapid && s.kind != nc::SegmentKind::Feed && s.kind != nc::SegmentKind::ToolChange) continue;
-    if (shapes.count(s.tool)) continue;
+    if (s.tool == 0 || shapes.count(s.tool)) continue;  // tool 0: empty spindle
     const auto it = profile.tools.find(s.tool);
     if (it == profile.tools.end())
       throw std::runtime_error(path.source + ":" + std::to_string(s.line) + ": tool " + std::to_string(s.tool) +
@@ -55,10 +57,12 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
     for (const auto& [n, sh] : shapes) dmax = std::max(dmax, sh.tool.diameter_mm);
     std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, dmax);
   }
-  BatchResult r{geom::LbrSolid(spec), 0, 0, 0, 0, 0, {}};
+  BatchResult r{geom::LbrSolid(spec), 0, 0, 0, 0, 0, {}, 1};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
   r.machining_time_s = machining_time_s(profile, path);
 
+  LevelPool pool(profile.threads);
+  r.threads = pool.threads();
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<geom::SweepRef> batch;
   batch.reserve(profile.batch_moves);
@@ -70,11 +74,15 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
     if (s.kind != nc::SegmentKind::Rapid && s.kind != nc::SegmentKind::Feed) continue;
     geom::Pose next = pose_of(s.end, s.tool_axis);
     if (!s.has_tool_axis) next.axis = pose.axis;
+    if (s.tool == 0) {  // no tool in the spindle (e.g. G28 before the first M6): nothing cuts
+      pose = next;
+      continue;
+    }
     batch.push_back({&shapes.at(s.tool), pose, next, static_cast<geom::MoveId>(i + 1)});
     pose = next;
     ++r.moves;
     if (static_cast<int>(batch.size()) >= profile.batch_moves) {
-      r.stats += r.solid.subtract(batch);
+      r.stats += pool.subtract(r.solid, batch);
       batch.clear();
       if (progress) {
         const auto now = std::chrono::steady_clock::now();
@@ -85,7 +93,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
       }
     }
   }
-  if (!batch.empty()) r.stats += r.solid.subtract(batch);
+  if (!batch.empty()) r.stats += pool.subtract(r.solid, batch);
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.removed_volume_mm3 = r.stock_volume_mm3 - r.solid.volume_mm3();
   if (progress) progress(1.0);

@@ -1,5 +1,6 @@
-// lbrsim — command-line entry point. Subcommands: batch, view, profile.
+// lbrsim — command-line entry point. Subcommands: batch, view, emulate, profile.
 #include <cstdio>
+#include <cmath>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "app/profile.hpp"
 #include "app/view.hpp"
 #include "gfx/window.hpp"
+#include "nc/emulator.hpp"
 
 #ifndef LBRSIM_VERSION
 #define LBRSIM_VERSION "dev"
@@ -22,11 +24,13 @@ namespace {
 using namespace lbr;
 
 struct BatchOptions {
-  std::string program, profile, stock, regions, out = "lbrsim-out";
+  std::string program, profile, stock, regions, out = "lbrsim-out", interpreter = "builtin";
   std::string stl, ply;  // mesh exports (empty: none)
   std::vector<std::string> tools;
   double level_spacing = 0.0;
+  int threads = -1;
   bool quiet = false;
+  bool sampled = false;
   // rendering (gfx/)
   std::string png, view = "iso", color = "plain", size = "1024x768";
   bool view_window = false;
@@ -40,12 +44,52 @@ struct ViewCliOptions {
   std::size_t frames = 0;
 };
 
+struct EmulateOptions {
+  std::string program, profile, period, out = "samples.csv", interpreter = "builtin";
+};
+
+app::Interpreter interpreter_of(const std::string& s) {
+  return s == "rs274" ? app::Interpreter::Rs274 : app::Interpreter::Builtin;
+}
+
+// "4ms", "4", "500us", "0.004s" -> milliseconds.
+double parse_period_ms(const std::string& s) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const std::string unit = used > 0 ? s.substr(used) : "";
+  double ms = v;
+  if (unit == "us") ms = v * 1e-3;
+  else if (unit == "s") ms = v * 1e3;
+  else if (!(unit.empty() || unit == "ms")) used = 0;
+  if (used == 0 || !std::isfinite(ms) || ms < 0.1 || ms > 1000.0)
+    throw std::runtime_error("--period " + s + ": expected a period between 0.1 ms and 1000 ms, e.g. 4ms, 500us");
+  return ms;
+}
+
+int run_emulate_command(const EmulateOptions& o) {
+  app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+  if (!o.period.empty()) profile.sample_period_ms = parse_period_ms(o.period);
+  const nc::Toolpath path = app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
+  nc::Emulator em(path, app::emulator_limits(profile));
+  const std::uint64_t n = app::write_samples_csv(o.out, em);
+  std::printf("%llu samples every %.4g ms | machining %.3f s | %zu segments | wrote %s\n",
+              static_cast<unsigned long long>(n), profile.sample_period_ms, em.total_time_s(), path.segments.size(),
+              o.out.c_str());
+  return 0;
+}
+
 app::Profile batch_profile(const BatchOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
   if (!o.stock.empty()) app::apply_stock_override(profile, o.stock);
   for (const std::string& t : o.tools) app::apply_tool_override(profile, t);
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
+  if (o.threads >= 0) profile.threads = o.threads;
   return profile;
 }
 
@@ -63,8 +107,12 @@ gfx::RenderThreadConfig render_config(const BatchOptions& o, const ViewCliOption
 }
 
 int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
+  if (!gfx::display_available())
+    throw gfx::DisplayError("lbrsim view needs a display (DISPLAY / WAYLAND_DISPLAY are not set); "
+                            "headless: `xvfb-run -a lbrsim view --hidden ...`");
   const app::Profile profile = batch_profile(o);
-  const nc::Toolpath path = o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile);
+  const nc::Toolpath path =
+      o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   app::ViewOptions vo;
   vo.render = render_config(o, v);
   vo.animate = v.animate;
@@ -72,9 +120,6 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
   vo.hidden = v.hidden;
   vo.frames = v.frames;
   vo.quiet = o.quiet;
-  if (!gfx::display_available())
-    throw gfx::DisplayError("lbrsim view needs a display (DISPLAY / WAYLAND_DISPLAY are not set); "
-                            "headless: `xvfb-run -a lbrsim view --hidden ...`");
   return app::run_view(profile, path, vo);
 }
 
@@ -93,15 +138,28 @@ int run_batch_command(const BatchOptions& o) {
                               "`xvfb-run -a lbrsim batch ... --png " + o.png + "`");
   }
 
-  const nc::Toolpath path = o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile);
+  nc::Toolpath path =
+      o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   const std::string program = o.program.empty() ? path.source : o.program;
   spdlog::info("program {} ({} segments), profile {}", program, path.segments.size(), profile.source);
+  // G-code programs and sampled runs take the emulator's time (acceleration, axis limits).
+  const bool emulated = o.sampled || (!o.program.empty() && app::is_gcode_path(o.program));
+  double emulated_time_s = 0.0;
+  if (emulated) {
+    const nc::EmulatorLimits limits = app::emulator_limits(profile);
+    emulated_time_s = nc::emulated_time_s(path, limits);
+    if (o.sampled) {
+      path = nc::sampled_toolpath(path, limits);
+      spdlog::info("sampled every {} ms: {} segments", profile.sample_period_ms, path.segments.size());
+    }
+  }
 
   app::Progress progress;
   if (!o.quiet) {
     progress = [](double f) { spdlog::info("progress {:5.1f} %", 100.0 * f); };
   }
-  const app::BatchResult r = app::run_batch(profile, path, progress);
+  app::BatchResult r = app::run_batch(profile, path, progress);
+  if (emulated) r.machining_time_s = emulated_time_s;
   app::write_batch_outputs(o.out, r, profile, program);
   std::printf("removed %.3f mm3 of %.3f mm3 | machining %.2f s | simulated in %.3f s (factor %.5f) | "
               "%d levels x %d regions (%dx%d), %zu vertices\n",
@@ -113,14 +171,11 @@ int run_batch_command(const BatchOptions& o) {
   if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
   if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
   if (!o.png.empty()) {
-    gfx::capture_png(r.solid, o.png, cap);
+    gfx::capture_png(r.solid, o.png, cap, app::final_tools(profile, path));
     std::printf("wrote %s (%dx%d, view %s, colour %s)\n", o.png.c_str(), cap.width, cap.height, o.view.c_str(),
                 o.color.c_str());
   }
-  if (o.view_window) {
-    ViewCliOptions v;
-    return run_view_command(o, v);
-  }
+  if (o.view_window) return run_view_command(o, ViewCliOptions{});
   return 0;
 }
 
@@ -137,7 +192,15 @@ int main(int argc, char** argv) {
   BatchOptions b;
   CLI::App* batch = cli.add_subcommand("batch", "Run a part program through the simulator as fast as possible");
   batch->add_option("--program", b.program,
-                    "Part program: a move list (.moves); without it the bundled demo program runs");
+                    "Part program: a move list (.moves) or G-code (.ngc, .nc, .gcode, .tap); without it the "
+                    "bundled demo program runs");
+  batch->add_option("--interpreter", b.interpreter,
+                    "G-code front end: builtin, or rs274 (LinuxCNC's interpreter, package linuxcnc-uspace)")
+      ->check(CLI::IsMember({"builtin", "rs274"}))
+      ->capture_default_str();
+  batch->add_flag("--sampled", b.sampled,
+                  "Run the kernel on the machine emulator's sampled stream (as live mode sees it) instead of the "
+                  "interpreted segments");
   batch->add_option("--profile", b.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
   batch->add_option("--stock", b.stock,
                     "Override the stock: box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX or cylinder:DIAMETER,ZMIN,ZMAX [mm]");
@@ -147,6 +210,8 @@ int main(int argc, char** argv) {
       ->take_all();
   batch->add_option("--level-spacing", b.level_spacing, "Level spacing Δ [mm]")->check(CLI::Range(0.001, 1000.0));
   batch->add_option("--regions", b.regions, "Region grid NXxNY (e.g. 4x4) or auto");
+  batch->add_option("--threads", b.threads, "Kernel worker threads (0 = one per hardware thread; default: profile)")
+      ->check(CLI::Range(0, 256));
   batch->add_option("--out", b.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
   batch->add_flag("--quiet", b.quiet, "No progress messages");
   batch->add_option("--stl", b.stl, "Also write the reconstructed part as binary STL to this file");
@@ -154,19 +219,24 @@ int main(int argc, char** argv) {
 
   auto add_render_options = [](CLI::App* c, BatchOptions& o) {
     c->add_option("--view", o.view, "Camera: top, front, side or iso")
-        ->check(CLI::IsMember({"top", "front", "side", "iso"}))->capture_default_str();
+        ->check(CLI::IsMember({"top", "front", "side", "iso"}))
+        ->capture_default_str();
     c->add_option("--color", o.color, "Colour mode: plain, heat (move of the last cut) or regions (grid)")
-        ->check(CLI::IsMember({"plain", "heat", "regions"}))->capture_default_str();
+        ->check(CLI::IsMember({"plain", "heat", "regions"}))
+        ->capture_default_str();
     c->add_option("--size", o.size, "Image / window size WxH [px]")->capture_default_str();
   };
   batch->add_option("--png", b.png, "Render the result offscreen to this PNG (needs a display; headless: xvfb-run -a)");
   add_render_options(batch, b);
-  batch->add_flag("--view-window", b.view_window, "Open the interactive viewer on the result");
+  batch->add_flag("--view-window", b.view_window, "Then open the interactive viewer on the program (runs it again)");
 
   BatchOptions vb;
   ViewCliOptions vv;
   CLI::App* view = cli.add_subcommand("view", "Interactive viewer: a batch result, or the program streamed in real time");
   view->add_option("--program", vb.program, "Part program (.moves or G-code); default: the bundled demo");
+  view->add_option("--interpreter", vb.interpreter, "G-code front end: builtin or rs274")
+      ->check(CLI::IsMember({"builtin", "rs274"}))
+      ->capture_default_str();
   view->add_option("--profile", vb.profile, "Machine profile (TOML)");
   view->add_option("--stock", vb.stock, "Override the stock (as for batch)");
   view->add_option("--tool", vb.tools, "Add or override a tool (as for batch)")->take_all();
@@ -185,6 +255,16 @@ int main(int argc, char** argv) {
   view->add_option("--screenshot-prefix", vv.screenshot_prefix, "Screenshot file prefix (PREFIX000123.png)")
       ->capture_default_str();
 
+  EmulateOptions em;
+  CLI::App* emu = cli.add_subcommand("emulate", "Run a part program through the machine emulator and write its samples");
+  emu->add_option("program", em.program, "Part program (G-code or .moves)")->required();
+  emu->add_option("--profile", em.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
+  emu->add_option("--period", em.period, "Sample period, e.g. 4ms, 500us (default: the profile's sample_period_ms)");
+  emu->add_option("--out", em.out, "CSV file (columns: docs/nc-frontend.md#samples-csv)")->capture_default_str();
+  emu->add_option("--interpreter", em.interpreter, "G-code front end: builtin or rs274")
+      ->check(CLI::IsMember({"builtin", "rs274"}))
+      ->capture_default_str();
+
   std::string check_path;
   bool print_default = false;
   CLI::App* prof = cli.add_subcommand("profile", "Check a profile, or print the built-in default profile");
@@ -198,6 +278,7 @@ int main(int argc, char** argv) {
   try {
     if (batch->parsed()) return run_batch_command(b);
     if (view->parsed()) return run_view_command(vb, vv);
+    if (emu->parsed()) return run_emulate_command(em);
     if (prof->parsed()) {
       if (print_default) {
         std::cout << app::default_profile_text();
