@@ -110,22 +110,22 @@ void RenderThread::loop() {
       ren.set_pacing(pacing);
       FrameInfo fi;
       const bool shot = cfg_.screenshot_every > 0 && report_.frames % static_cast<std::uint64_t>(cfg_.screenshot_every) == 0;
-      if (shot || !win_.visible()) {
-        // Hidden windows draw offscreen (their default framebuffer may not be backed).
-        Image img = ren.render_offscreen(cam, w, h, false, &fi);
-        if (shot) {
-          char name[32];
-          std::snprintf(name, sizeof name, "%06llu.png", static_cast<unsigned long long>(report_.frames));
-          write_png(cfg_.screenshot_prefix + name, img);
-          ++report_.screenshots;
-        }
+      // Hidden windows draw offscreen (their default framebuffer may not be backed).
+      if (shot) {
+        const Image img = ren.render_offscreen(cam, w, h, false, &fi);
+        char name[32];
+        std::snprintf(name, sizeof name, "%06llu.png", static_cast<unsigned long long>(report_.frames));
+        write_png(cfg_.screenshot_prefix + name, img);
+        ++report_.screenshots;
+      } else if (!win_.visible()) {
+        fi = ren.frame_offscreen(cam, w, h);
       }
       if (win_.visible()) {
         const FrameInfo f2 = ren.frame(cam, w, h);
         if (!shot) fi = f2;
         glfwSwapBuffers(win_.handle());
       } else {
-        glFlush();
+        glFinish();  // the frame's work is done (and measured) within its own period
       }
       const double work = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
       pacing.frame_ms = work;

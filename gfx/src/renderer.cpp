@@ -387,8 +387,21 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
     Gl::Region& gr = g.regions[static_cast<std::size_t>(r)];
     const mesh::MeshBuffers& mb = mirror_.meshes().region(r);
     if (gr.generation == mb.generation) continue;
-    Gl::upload(gr.vao, gr.vbo, gr.ebo, mb.positions, mb.normals, mb.attributes, mb.indices);
-    gr.count = static_cast<GLsizei>(mb.indices.size());
+    // Joined walls keep zero-area triangles for the mesh's edge identities (docs/mesh.md
+    // §2); they draw nothing, so they are left out of the GPU index buffer.
+    upload_idx_.clear();
+    upload_idx_.reserve(mb.indices.size());
+    const float* P = mb.positions.data();
+    for (std::size_t i = 0; i + 2 < mb.indices.size(); i += 3) {
+      const std::uint32_t a = mb.indices[i], b = mb.indices[i + 1], c = mb.indices[i + 2];
+      const glm::vec3 pa(P[3 * a], P[3 * a + 1], P[3 * a + 2]), pb(P[3 * b], P[3 * b + 1], P[3 * b + 2]),
+          pc(P[3 * c], P[3 * c + 1], P[3 * c + 2]);
+      const glm::vec3 n = glm::cross(pb - pa, pc - pa);
+      if (glm::dot(n, n) <= 1e-14f) continue;  // area below 5e-8 mm²
+      upload_idx_.insert(upload_idx_.end(), {a, b, c});
+    }
+    Gl::upload(gr.vao, gr.vbo, gr.ebo, mb.positions, mb.normals, mb.attributes, upload_idx_);
+    gr.count = static_cast<GLsizei>(upload_idx_.size());
     gr.generation = mb.generation;
     ++gr.uploads;
     ++fi.regions_uploaded;
@@ -411,7 +424,11 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
-  glDisable(GL_CULL_FACE);
+  // The stock's surface is closed and counter-clockwise from outside (docs/mesh.md), so
+  // back faces are never visible: culling them halves the rasteriser's work (llvmpipe).
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
   glUseProgram(g.prog);
   const glm::mat4 vpf = to_f(vp);
   glUniformMatrix4fv(g.u_vp, 1, GL_FALSE, glm::value_ptr(vpf));
@@ -443,6 +460,7 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
     fi.triangles += static_cast<std::uint64_t>(gr.count / 3);
   }
 
+  glDisable(GL_CULL_FACE);
   if (opt_.show_tools) {
     glUniform1i(g.u_mode, 3);
     glBindVertexArray(g.cyl_vao);
@@ -505,6 +523,14 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
   }
   fi.draw_ms = std::chrono::duration<double, std::milli>(clock::now() - t2).count();
   last_ = fi;
+  return fi;
+}
+
+FrameInfo Renderer::frame_offscreen(const Camera& cam, int w, int h) {
+  gl_->ensure_fbo(w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo);
+  const FrameInfo fi = frame(cam, w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return fi;
 }
 

@@ -81,6 +81,8 @@ class Renderer {
   // One frame into the currently bound framebuffer of w × h pixels: bounded rebuild of
   // visible pending regions, upload of changed region buffers, draw.
   FrameInfo frame(const Camera& cam, int w, int h);
+  // Same, into an offscreen framebuffer (hidden windows), without reading it back.
+  FrameInfo frame_offscreen(const Camera& cam, int w, int h);
   // Same, into an offscreen framebuffer; returns the pixels (and depth when asked).
   Image render_offscreen(const Camera& cam, int w, int h, bool with_depth = false, FrameInfo* info = nullptr);
 
@@ -104,6 +106,7 @@ class Renderer {
   PacingInfo pacing_;
   std::uint64_t version_ = 0;
   int limit_ = 4;
+  std::vector<std::uint32_t> upload_idx_;
   FrameInfo last_;
 };
 

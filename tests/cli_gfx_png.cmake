@@ -1,0 +1,60 @@
+# lbrsim's rendering from the command line (issue 6), run by ctest with -DLBRSIM=... -DOUT=...
+#  1. `batch --png` under xvfb-run writes a PNG of the requested size;
+#  2. without any display, `batch --png` fails cleanly with a message suggesting xvfb-run;
+#  3. `view --hidden --frames N --screenshot-every M` runs the render thread headless.
+file(REMOVE_RECURSE "${OUT}")
+file(MAKE_DIRECTORY "${OUT}")
+
+function(png_size file out_w out_h)
+  file(READ "${file}" hex LIMIT 24 HEX)
+  string(SUBSTRING "${hex}" 0 16 sig)
+  if(NOT sig STREQUAL "89504e470d0a1a0a")
+    message(FATAL_ERROR "${file} is not a PNG (signature ${sig})")
+  endif()
+  string(SUBSTRING "${hex}" 32 8 w)
+  string(SUBSTRING "${hex}" 40 8 h)
+  math(EXPR w "0x${w}")
+  math(EXPR h "0x${h}")
+  set(${out_w} ${w} PARENT_SCOPE)
+  set(${out_h} ${h} PARENT_SCOPE)
+endfunction()
+
+execute_process(COMMAND xvfb-run -a "${LBRSIM}" batch --quiet --out "${OUT}/run" --png "${OUT}/top.png" --view top
+                        --color heat --size 320x240
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "batch --png failed (${rc}): ${out} ${err}")
+endif()
+png_size("${OUT}/top.png" w h)
+if(NOT w EQUAL 320 OR NOT h EQUAL 240)
+  message(FATAL_ERROR "top.png is ${w}x${h}, expected 320x240")
+endif()
+
+execute_process(COMMAND "${CMAKE_COMMAND}" -E env --unset=DISPLAY --unset=WAYLAND_DISPLAY
+                        "${LBRSIM}" batch --quiet --out "${OUT}/run2" --png "${OUT}/none.png"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(rc EQUAL 0)
+  message(FATAL_ERROR "batch --png without a display succeeded")
+endif()
+if(NOT rc EQUAL 1 OR NOT err MATCHES "xvfb-run" OR NOT err MATCHES "DISPLAY")
+  message(FATAL_ERROR "batch --png without a display: expected exit 1 and a hint to use xvfb-run, got ${rc}: ${err}")
+endif()
+if(EXISTS "${OUT}/none.png")
+  message(FATAL_ERROR "none.png was written without a display")
+endif()
+
+execute_process(COMMAND xvfb-run -a "${LBRSIM}" view --quiet --hidden --frames 10 --screenshot-every 5
+                        --screenshot-prefix "${OUT}/shot-" --size 200x150 --color regions
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "frames 10 ")
+  message(FATAL_ERROR "view --hidden failed (${rc}): ${out} ${err}")
+endif()
+foreach(f shot-000000.png shot-000005.png)
+  if(NOT EXISTS "${OUT}/${f}")
+    message(FATAL_ERROR "view --hidden did not write ${f}")
+  endif()
+  png_size("${OUT}/${f}" w h)
+  if(NOT w EQUAL 200 OR NOT h EQUAL 150)
+    message(FATAL_ERROR "${f} is ${w}x${h}, expected 200x150")
+  endif()
+endforeach()
