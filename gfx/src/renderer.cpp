@@ -125,9 +125,11 @@ void main() {
   vec3 F = normalize(vec3(-u_key.x, -u_key.y, 0.35));  // fill from the opposite side
   float d = max(dot(n, L), 0.0), f = max(dot(n, F), 0.0);
   vec3 H = normalize(L + V);
-  float s = pow(max(dot(n, H), 0.0), 48.0) * 0.35;
-  vec3 c = base * (0.28 + 0.62 * d + 0.22 * f) + vec3(s);
-  o_col = vec4(pow(c, vec3(1.0 / 1.1)), 1.0);
+  // Specular ~ (n·h)^32 by squaring (cheaper than pow() on a software rasteriser).
+  float s = max(dot(n, H), 0.0);
+  s *= s; s *= s; s *= s; s *= s; s *= s;
+  vec3 c = base * (0.30 + 0.64 * d + 0.22 * f) + vec3(0.3 * s);
+  o_col = vec4(c, 1.0);
 })";
 
 glm::mat4 to_f(const glm::dmat4& m) { return glm::mat4(m); }
