@@ -132,7 +132,7 @@ TEST_F(GfxRender, PocketFloorMatchesAnalyticProjectionThenOnlyTheChangedRegionIs
       }
       if (is_top) {
         ++top_px;
-        if (chroma(img.px(x, y)) < 8) ++top_grey;
+        if (chroma(img.px(x, y)) < 16) ++top_grey;
         EXPECT_FALSE(in_pocket(p.x, p.y, -band)) << "top face inside the pocket at " << x << "," << y;
       }
     }
