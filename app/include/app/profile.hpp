@@ -8,6 +8,7 @@
 
 #include "geom/lbr_solid.hpp"
 #include "geom/tool.hpp"
+#include "hal/config.hpp"
 
 namespace lbr::app {
 
@@ -26,6 +27,7 @@ struct Profile {
   bool regions_auto = false;
   int batch_moves = 64;     // moves per subtract() call in batch mode
   std::map<int, geom::Tool> tools;
+  hal::LiveConfig live;     // [live], [[live.axis]], [threads]: `lbrsim run` (docs/profiles.md)
 };
 
 // Parses profile text; `name` is used in messages. Throws ProfileError("name:line: ...").

@@ -39,8 +39,9 @@ struct LiveConfig {
   std::vector<AxisMap> axes;       // empty = X,Y,Z on channel 0, nodes 1..3, indices 0..2
   double jump_tolerance = 1.5;     // allowed step = max_speed × Δt × tolerance + 2 counts
   int tool = 1;                    // tool in the spindle (samples carry no tool number)
+  double merge_tolerance_mm = 0.001;  // samples within this of a straight sweep extend it
   std::size_t ring_capacity = 4096;
-  int geometry_period_ms = 1;      // geometry thread drains the ring every period
+  int geometry_idle_us = 1000;     // geometry thread looks at an empty ring again after this [µs]
   CanConfig can;
   SerialConfig serial;
   sched::RtConfig hal_thread{"lbr-hal", 80, -1, true};
