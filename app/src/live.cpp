@@ -105,11 +105,12 @@ class Geometry {
     for (Channel& c : ch_) c.run.reserve(kMaxRun + 1);
   }
 
-  // Applies everything in the ring (up to its capacity); returns the samples applied.
-  std::size_t tick() noexcept {
+  // Applies what is in the ring, at most `limit` samples; returns the samples applied.
+  std::size_t tick(std::size_t limit) noexcept {
     batch_.clear();
     std::size_t n = 0;
-    while (n < rx_.size()) {
+    limit = std::min(limit, rx_.size());
+    while (n < limit) {
       AxisSample* s = ring_.front();
       if (s == nullptr) break;
       take(*s);
@@ -263,6 +264,9 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
 
   // Geometry thread: apply whatever is in the ring at once; when it was empty, look again
   // after geometry_idle_us (so a sample waits at most that long before work starts).
+  // Sources that are not live (replay/emulator as fast as possible) are applied in chunks
+  // of exactly lbr.batch_moves samples, so such a run is reproducible bit for bit.
+  const std::size_t chunk = backpressure ? static_cast<std::size_t>(profile.batch_moves) : ring.capacity();
   std::atomic<bool> geo_running{true};
   std::atomic<int> geo_mode{-1};
   const std::int64_t idle_ns = static_cast<std::int64_t>(cfg.geometry_idle_us) * 1000;
@@ -270,7 +274,7 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
     geo_mode = sched::configure_current_thread(cfg.geometry_thread) == sched::RtMode::Fifo ? 1 : 0;
     for (;;) {
       const bool finished = hal_done.load(std::memory_order_acquire);
-      if (geo.tick() > 0) continue;
+      if ((finished || !backpressure || ring.size() >= chunk) && geo.tick(chunk) > 0) continue;
       if (finished && ring.front() == nullptr) break;
       sched::sleep_until_ns(sched::now_ns() + idle_ns);
     }

@@ -1,10 +1,14 @@
 // SerialSource: LibSerial opens and configures the port (8N1, raw, baud from the profile);
-// the HAL loop then uses poll()+read() on its descriptor, because LibSerial reports
-// timeouts with exceptions and the RT path must not throw.
+// we then take over a duplicate of its descriptor with those settings and close the
+// LibSerial object. The HAL loop uses poll()+read(), because LibSerial reports timeouts
+// (and a hung-up port on close) with exceptions and the RT path must not throw.
 #include <poll.h>
 #include <unistd.h>
 
+#include <termios.h>
+
 #include <cerrno>
+#include <cstring>
 #include <stdexcept>
 
 #include <libserial/SerialPort.h>
@@ -44,17 +48,29 @@ class SerialSource final : public Source {
   ~SerialSource() override { close(); }
 
   void open() override {
+    termios settings{};
+    int fd = -1;
     try {
-      port_.Open(dev_);
-      port_.SetBaudRate(baud_);
-      port_.SetCharacterSize(LibSerial::CharacterSize::CHAR_SIZE_8);
-      port_.SetParity(LibSerial::Parity::PARITY_NONE);
-      port_.SetStopBits(LibSerial::StopBits::STOP_BITS_1);
-      port_.SetFlowControl(LibSerial::FlowControl::FLOW_CONTROL_NONE);
+      LibSerial::SerialPort port;
+      port.Open(dev_);
+      port.SetBaudRate(baud_);
+      port.SetCharacterSize(LibSerial::CharacterSize::CHAR_SIZE_8);
+      port.SetParity(LibSerial::Parity::PARITY_NONE);
+      port.SetStopBits(LibSerial::StopBits::STOP_BITS_1);
+      port.SetFlowControl(LibSerial::FlowControl::FLOW_CONTROL_NONE);
+      fd = ::dup(port.GetFileDescriptor());
+      if (fd < 0 || ::tcgetattr(fd, &settings) != 0) throw std::runtime_error(std::strerror(errno));
+      port.Close();  // restores the settings it found; ours are re-applied below
     } catch (const std::exception& e) {
+      if (fd >= 0) ::close(fd);
       throw std::runtime_error("serial:" + dev_ + ": " + e.what());
     }
-    fd_ = port_.GetFileDescriptor();
+    if (::tcsetattr(fd, TCSANOW, &settings) != 0) {
+      const int e = errno;
+      ::close(fd);
+      throw std::runtime_error("serial:" + dev_ + ": tcsetattr: " + std::strerror(e));
+    }
+    fd_ = fd;
   }
 
   PollResult poll(int timeout_ms, SampleSink& sink) noexcept override {
@@ -100,13 +116,8 @@ class SerialSource final : public Source {
   }
 
   void close() noexcept override {
-    if (fd_ >= 0) {
-      try {
-        port_.Close();
-      } catch (...) {
-      }
-      fd_ = -1;
-    }
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
   }
   [[nodiscard]] std::string describe() const override { return "serial:" + dev_; }
   [[nodiscard]] std::uint64_t lost() const noexcept override { return dec_.gaps() + mapped_lost_; }
@@ -115,7 +126,6 @@ class SerialSource final : public Source {
   std::string dev_;
   LiveConfig cfg_;
   LibSerial::BaudRate baud_;
-  LibSerial::SerialPort port_;
   int fd_ = -1;
   std::array<std::uint8_t, 1024> buf_{};
   SerialStreamDecoder dec_;
