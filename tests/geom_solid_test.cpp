@@ -102,3 +102,18 @@ TEST(Solid, BoxCullingSkipsFarCells) {
   EXPECT_EQ(st.cells_clipped, 10u);
   EXPECT_EQ(st.sections, 10u);
 }
+
+TEST(Solid, BooleanDifferenceOfTwoSolids) {
+  // Box 40 x 40 x 10 minus a cylinder Ø20 standing on z = -4 inside it: π·100·4 removed.
+  geom::LbrSolid a(test::box_spec({0, 0, -10}, {40, 40, 0}, 0.1, 2, 2));
+  geom::SolidSpec cs;
+  cs.shape = geom::SolidSpec::Shape::Cylinder;
+  cs.cylinder = {20, 20, 20, -4, 6};
+  cs.level_spacing_mm = 0.1;
+  cs.regions_x = cs.regions_y = 3;
+  const geom::LbrSolid b(cs);
+  const geom::SubtractStats st = a.subtract_solid(b, 3);
+  EXPECT_EQ(st.cells_changed, 4u * 40u);
+  EXPECT_NEAR(test::removed(a), test::kPi * 100.0 * 4.0, 2 * test::kPi * 20.0 * 0.001 * 4.0);
+  EXPECT_EQ(a.check_invariants(), "");
+}

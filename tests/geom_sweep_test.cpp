@@ -115,3 +115,20 @@ TEST(Sweep, RotatingAxisIsSubdividedAndCoversBothEnds) {
   // Bounded by the hull of the two ellipses' extents: x from -5 to 8 tan(20°) + 5/cos(20°).
   EXPECT_LT(ar, (8.0 * std::tan(th) + 5.0 / std::cos(th) + 5.0) * 10.0);
 }
+
+TEST(Sweep, StadiumFastPathAgreesWithGeneralPathInAnyDirection) {
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  const geom::Vec3 almost{0, 1e-9, 1};
+  for (double deg : {0.0, 17.0, 45.0, 90.0, 133.3, 180.0, 271.0}) {
+    const double a = deg * test::kPi / 180.0;
+    const geom::Vec3 e{7.0 * std::cos(a), 7.0 * std::sin(a), 0.0};
+    const geom::Sweep fast(shape, test::at(0, 0, 0), test::at(e.x, e.y, 0));
+    const geom::Sweep gen(shape, test::at(0, 0, 0, almost), test::at(e.x, e.y, 0, almost));
+    for (double z : {0.5, 2.0, 4.0}) {
+      const double r = shape.radius_at(z);
+      const double exact = 2 * r * 7.0 + test::kPi * r * r;
+      EXPECT_NEAR(section_area_mm2(fast, z), exact, 2 * (14.0 + 2 * test::kPi * r) * kTol) << deg << " " << z;
+      EXPECT_NEAR(section_area_mm2(gen, z), exact, 2 * (14.0 + 2 * test::kPi * r) * kTol) << deg << " " << z;
+    }
+  }
+}

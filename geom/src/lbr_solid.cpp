@@ -230,13 +230,59 @@ SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch, SubtractWorksp
   return subtract_levels(batch, 0, levels_, ws);
 }
 
+namespace {
+
+bool same_axis(const Vec3& a, const Vec3& b) noexcept { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+// Distance from p to the segment a-b [mm].
+double dist_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) noexcept {
+  const Vec3 ab = b - a;
+  const double l2 = dot(ab, ab);
+  const double t = l2 > 0.0 ? std::clamp(dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+  return norm(p - (a + t * ab));
+}
+
+}  // namespace
+
+void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out) {
+  out.clear();
+  constexpr std::size_t kMaxRun = 512;
+  std::size_t i = 0;
+  while (i < batch.size()) {
+    const SweepRef& first = batch[i];
+    if (first.shape == nullptr) {
+      ++i;
+      continue;
+    }
+    SweepRef merged = first;
+    const double tol = 0.5 * first.shape->chord_tol_mm;
+    std::size_t j = i + 1;
+    // Extend the run while the next move continues this one with the same tool and a fixed
+    // axis, and every intermediate point stays within tol/2 of the merged chord.
+    while (j < batch.size() && j - i < kMaxRun) {
+      const SweepRef& n = batch[j];
+      if (n.shape != first.shape || !(n.from.tip == merged.to.tip) || !same_axis(n.from.axis, first.from.axis) ||
+          !same_axis(n.to.axis, first.from.axis) || !same_axis(first.to.axis, first.from.axis))
+        break;
+      bool ok = true;
+      for (std::size_t k = i; k < j && ok; ++k) ok = dist_to_segment(batch[k].to.tip, first.from.tip, n.to.tip) <= tol;
+      if (!ok) break;
+      merged.to = n.to;
+      merged.id = std::max(merged.id, n.id);
+      ++j;
+    }
+    out.push_back(merged);
+    i = j;
+  }
+}
+
 SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
                                         SubtractWorkspace& ws) {
   SubtractStats stats;
+  merge_collinear(batch, ws.merged);
   ws.sweeps.clear();
   double zlo = INFINITY, zhi = -INFINITY;
-  for (const SweepRef& s : batch) {
-    if (s.shape == nullptr) continue;
+  for (const SweepRef& s : ws.merged) {
     ws.sweeps.emplace_back(*s.shape, s.from, s.to);
     zlo = std::min(zlo, ws.sweeps.back().z_min());
     zhi = std::max(zhi, ws.sweeps.back().z_max());
@@ -244,30 +290,26 @@ SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int lev
   if (ws.sweeps.empty() || zhi < z0_ || zlo > z1_) return stats;
   const int lb = std::max(level_begin, level_at(zlo));
   const int le = std::min(level_end, level_at(zhi) + 1);
-  for (int l = lb; l < le; ++l) stats += subtract_level(batch, l, ws);
+  for (int l = lb; l < le; ++l) stats += subtract_level(l, ws);
   return stats;
 }
 
-SubtractStats LbrSolid::subtract_level(std::span<const SweepRef> batch, int level, SubtractWorkspace& ws) {
+SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
   SubtractStats stats;
   const double zc = level_z_mm(level);
   ws.sections.clear();
   ws.section_box.clear();
   ws.section_id.clear();
   Rect all;
-  {
-    std::size_t si = 0;
-    for (const SweepRef& s : batch) {
-      if (s.shape == nullptr) continue;
-      const Sweep& sw = ws.sweeps[si++];
-      if (zc < sw.z_min() || zc > sw.z_max()) continue;
-      const std::size_t before = ws.sections.size();
-      sw.section(zc, ws.sections, ws.scratch);
-      for (std::size_t k = before; k < ws.sections.size(); ++k) {
-        ws.section_box.push_back(bounds_of(ws.sections[k]));
-        ws.section_id.push_back(s.id);
-        all.add(ws.section_box.back());
-      }
+  for (std::size_t si = 0; si < ws.sweeps.size(); ++si) {
+    const Sweep& sw = ws.sweeps[si];
+    if (zc < sw.z_min() || zc > sw.z_max()) continue;
+    const std::size_t before = ws.sections.size();
+    sw.section(zc, ws.sections, ws.scratch);
+    for (std::size_t k = before; k < ws.sections.size(); ++k) {
+      ws.section_box.push_back(bounds_of(ws.sections[k]));
+      ws.section_id.push_back(ws.merged[si].id);
+      all.add(ws.section_box.back());
     }
   }
   stats.sections = ws.sections.size();
@@ -374,6 +416,54 @@ SubtractStats LbrSolid::subtract_level(std::span<const SweepRef> batch, int leve
       }
       for (Polygon& poly : ws.fresh) ws.kept.push_back(std::move(poly));
       cell.polys.swap(ws.kept);
+      detail::refresh_cell(cell);
+      ++cell.version;
+      dirty_flag_[ci] = 1;
+      ++stats.cells_changed;
+    }
+  }
+  return stats;
+}
+
+SubtractStats LbrSolid::subtract_solid(const LbrSolid& other, MoveId id) {
+  SubtractStats stats;
+  SubtractWorkspace& ws = *ws_;
+  Paths clip;
+  for (int l = 0; l < levels_; ++l) {
+    const double z = level_z_mm(l);
+    if (z < other.z0_ || z > other.z1_) continue;
+    const int ol = other.level_at(z);
+    clip.clear();
+    Rect cb;
+    for (int r = 0; r < other.regions(); ++r) {
+      const Cell& oc = other.cell(r, ol);
+      flatten(oc, clip);
+      cb.add(oc.bbox);
+    }
+    if (clip.empty()) continue;
+    stats.sections += clip.size();
+    for (int reg = 0; reg < regions(); ++reg) {
+      const std::size_t ci = static_cast<std::size_t>(reg) * levels_ + l;
+      Cell& cell = cells_[ci];
+      if (!cell.bbox.intersects(cb)) continue;
+      ++stats.cells_tested;
+      ClipperLib::Clipper& c = ws.clipper;
+      c.Clear();
+      c.StrictlySimple(spec_.strictly_simple);
+      Paths subject;
+      flatten(cell, subject);
+      c.AddPaths(subject, ClipperLib::ptSubject, true);
+      c.AddPaths(clip, ClipperLib::ptClip, true);
+      ws.tree.Clear();
+      c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+      ++stats.cells_clipped;
+      ws.fresh.clear();
+      detail::append_polygons(ws.tree, ws.fresh);
+      for (Polygon& p : ws.fresh) {
+        p.outer.cut_by = id;
+        for (Contour& h : p.holes) h.cut_by = id;
+      }
+      cell.polys.swap(ws.fresh);
       detail::refresh_cell(cell);
       ++cell.version;
       dirty_flag_[ci] = 1;

@@ -244,6 +244,49 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
   // Vertices at ρ = 2r / (1 + cos(π/n)): the polygon then deviates from the circle by at
   // most ±(ρ - r), i.e. half the chord band, on either side.
   const double grow = 2.0 / (1.0 + std::cos(std::numbers::pi / n));
+  if (sc.table_n != n) {
+    sc.cos_t.resize(n);
+    sc.sin_t.resize(n);
+    for (int k = 0; k < n; ++k) {
+      const double a = 2.0 * std::numbers::pi * k / n;
+      sc.cos_t[k] = std::cos(a);
+      sc.sin_t[k] = std::sin(a);
+    }
+    sc.table_n = n;
+  }
+  sc.hull.clear();
+  if (sc.disks.size() == 2 && sc.disks[0].r == sc.disks[1].r) {
+    // Horizontal move (the common case): the hull of two equal n-gons on one angle grid is
+    // the far half of each, walked counter-clockwise: vertices of the end disk facing the
+    // direction of motion, then those of the start disk facing away from it.
+    const auto& a = sc.disks[0];
+    const auto& b = sc.disks[1];
+    const double dx = b.x - a.x, dy = b.y - a.y;
+    const double rho = a.r * grow;
+    if (dx == 0.0 && dy == 0.0) {
+      for (int k = 0; k < n; ++k) sc.hull.push_back({a.x + rho * sc.cos_t[k], a.y + rho * sc.sin_t[k]});
+    } else {
+      // The side edges join the two polygons' extreme vertices in the directions normal to
+      // the motion: grid indices k_right (θ - 90°) and k_left (θ + 90°).
+      const double step = 2.0 * std::numbers::pi / n;
+      const double th = std::atan2(dy, dx);
+      auto nearest = [&](double ang) {
+        const long k = std::lround(ang / step);
+        return static_cast<int>(((k % n) + n) % n);
+      };
+      const int k_right = nearest(th - 0.5 * std::numbers::pi);
+      const int k_left = nearest(th + 0.5 * std::numbers::pi);
+      for (int k = k_right;; k = (k + 1) % n) {  // front half: end disk
+        sc.hull.push_back({b.x + rho * sc.cos_t[k], b.y + rho * sc.sin_t[k]});
+        if (k == k_left) break;
+      }
+      for (int k = k_left;; k = (k + 1) % n) {  // back half: start disk
+        sc.hull.push_back({a.x + rho * sc.cos_t[k], a.y + rho * sc.sin_t[k]});
+        if (k == k_right) break;
+      }
+    }
+    return emit(sc.hull, out);
+  }
   sc.pts.clear();
   for (const auto& d : sc.disks) {
     if (d.r <= 0.0) {
@@ -251,10 +294,7 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
       continue;
     }
     const double rho = d.r * grow;
-    for (int k = 0; k < n; ++k) {
-      const double a = 2.0 * std::numbers::pi * k / n;
-      sc.pts.push_back({d.x + rho * std::cos(a), d.y + rho * std::sin(a)});
-    }
+    for (int k = 0; k < n; ++k) sc.pts.push_back({d.x + rho * sc.cos_t[k], d.y + rho * sc.sin_t[k]});
   }
   convex_hull(sc.pts, sc.hull);
   return emit(sc.hull, out);

@@ -83,7 +83,8 @@ struct SubtractWorkspace {
   ClipperLib::Clipper clipper;
   ClipperLib::PolyTree tree;
   SectionScratch scratch;
-  std::vector<Sweep> sweeps;
+  std::vector<SweepRef> merged;   // the batch after merging collinear runs
+  std::vector<Sweep> sweeps;      // one per merged move
   Paths sections;                 // section polygons of the current level
   std::vector<Rect> section_box;  // their bounding boxes
   std::vector<MoveId> section_id; // their move ids
@@ -111,6 +112,11 @@ class LbrSolid {
   // may run disjoint level ranges on several threads, each with its own workspace.
   SubtractStats subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
                                 SubtractWorkspace& ws);
+
+  // 3D boolean difference with another LBR solid (the paper's OpBool): every level of this
+  // solid loses the polygons of the other solid's level that contains the same mid-plane
+  // height. Changed cells become dirty; cut contours get `id`. Allocates.
+  SubtractStats subtract_solid(const LbrSolid& other, MoveId id = 0);
 
   // --- geometry of the grid ---
   [[nodiscard]] const SolidSpec& spec() const noexcept { return spec_; }
@@ -161,7 +167,7 @@ class LbrSolid {
 
  private:
   void init_cells();
-  SubtractStats subtract_level(std::span<const SweepRef> batch, int level, SubtractWorkspace& ws);
+  SubtractStats subtract_level(int level, SubtractWorkspace& ws);
 
   SolidSpec spec_;
   int levels_ = 0;
@@ -173,6 +179,12 @@ class LbrSolid {
   double initial_volume_mm3_ = 0;
   std::unique_ptr<SubtractWorkspace> ws_;
 };
+
+// Merges runs of consecutive moves of one tool with a fixed axis into single moves when no
+// intermediate point lies farther than half the chord tolerance from the merged chord (so the
+// swept region moves by at most that much). The merged move keeps the largest move id.
+// Sampled straight lines collapse to one move each. Allocates only when `out` grows.
+void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out);
 
 // Fills `out` with the polygons of `cell` as a flat list of contours (outer then holes).
 void flatten(const Cell& cell, Paths& out);

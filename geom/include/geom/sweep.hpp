@@ -38,6 +38,9 @@ struct SectionScratch {
     P2 p;
   };
   std::vector<Dir> dirs;
+  // Unit circle for the last segment count used.
+  int table_n = 0;
+  std::vector<double> cos_t, sin_t;
 };
 
 class Sweep {
