@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   std::string program, profile_path, iface = "vcan0";
   double speed = 1.0;
   bool status_word = false;
+  std::size_t max_samples = 0;
   tools::FaultPlan f;
   cli.add_option("--program", program, "Move list (.moves); default: the bundled demo");
   cli.add_option("--profile", profile_path, "Profile (period, [[live.axis]] mapping, [live.can]); default: built-in");
@@ -36,10 +37,12 @@ int main(int argc, char** argv) {
   cli.add_option("--drop-every", f.drop_every, "Leave out every Nth TPDO");
   cli.add_option("--duplicate-every", f.duplicate_every, "Send every Nth TPDO twice");
   cli.add_option("--seed", f.seed, "Seed of the fault injection");
+  cli.add_option("--max-samples", max_samples, "Stop after this many samples (0 = whole program)");
   CLI11_PARSE(cli, argc, argv);
   try {
     const app::Profile profile = profile_path.empty() ? app::default_profile() : app::load_profile(profile_path);
-    const tools::Stream stream = tools::make_stream(profile, program);
+    tools::Stream stream = tools::make_stream(profile, program);
+    if (max_samples > 0 && stream.counts.size() > max_samples) stream.counts.resize(max_samples);
     const int s = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
     if (s < 0) throw std::runtime_error(std::string("socket(PF_CAN): ") + std::strerror(errno));
     ifreq ifr{};

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   std::string program, profile_path, device, pty_link;
   double speed = 1.0;
   int wait_ms = 10000;
+  std::size_t max_samples = 0;
   tools::FaultPlan f;
   cli.add_option("--program", program, "Move list (.moves); default: the bundled demo");
   cli.add_option("--profile", profile_path, "Profile (period, [[live.axis]] mapping); default: built-in");
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
   cli.add_option("--drop-every", f.drop_every, "Leave out every Nth frame");
   cli.add_option("--duplicate-every", f.duplicate_every, "Send every Nth frame twice");
   cli.add_option("--seed", f.seed, "Seed of the fault injection");
+  cli.add_option("--max-samples", max_samples, "Stop after this many samples (0 = whole program)");
   CLI11_PARSE(cli, argc, argv);
   if (device.empty() == pty_link.empty()) {
     std::fprintf(stderr, "lbr-feed-serial: give --device or --pty-link\n");
@@ -67,7 +69,8 @@ int main(int argc, char** argv) {
   }
   try {
     const app::Profile profile = profile_path.empty() ? app::default_profile() : app::load_profile(profile_path);
-    const tools::Stream stream = tools::make_stream(profile, program);
+    tools::Stream stream = tools::make_stream(profile, program);
+    if (max_samples > 0 && stream.counts.size() > max_samples) stream.counts.resize(max_samples);
     int fd = -1;
     if (!pty_link.empty()) {
       int master = -1, slave = -1;
