@@ -11,6 +11,8 @@ PACKAGES=(
   libglfw3-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
+  # libFuzzer decoder targets (tools/test.sh builds them with clang)
+  clang
 )
 
 missing=()
