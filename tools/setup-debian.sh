@@ -13,6 +13,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
   # libFuzzer decoder targets (tools/test.sh builds them with clang)
   clang
+  # HIL bench (tools/hil/hil-bench.sh): VM with Debian's kernel, vcan, busybox initramfs
+  qemu-system-x86 busybox-static cpio
 )
 
 missing=()

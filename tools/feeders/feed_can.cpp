@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   double speed = 1.0;
   bool status_word = false;
   std::size_t max_samples = 0;
+  int priority = 0;
   tools::FaultPlan f;
   cli.add_option("--program", program, "Move list (.moves); default: the bundled demo");
   cli.add_option("--profile", profile_path, "Profile (period, [[live.axis]] mapping, [live.can]); default: built-in");
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
   cli.add_option("--duplicate-every", f.duplicate_every, "Send every Nth TPDO twice");
   cli.add_option("--seed", f.seed, "Seed of the fault injection");
   cli.add_option("--max-samples", max_samples, "Stop after this many samples (0 = whole program)");
+  cli.add_option("--priority", priority, "Run the sending loop SCHED_FIFO at this priority (0 = normal)")->check(CLI::Range(0, 99));
   CLI11_PARSE(cli, argc, argv);
   try {
     const app::Profile profile = profile_path.empty() ? app::default_profile() : app::load_profile(profile_path);
@@ -60,6 +62,7 @@ int main(int argc, char** argv) {
       }
     };
     std::uint64_t syncs = 0, tpdos = 0, corrupted = 0, dropped = 0, duplicated = 0, k_tpdo = 0;
+    if (priority > 0) (void)sched::configure_current_thread(sched::RtConfig{"lbr-feed", priority, -1, true});
     const std::int64_t t0 = sched::now_ns();
     const auto period_ns = static_cast<std::int64_t>(stream.period_s * 1e9);
     int counter = 0;
