@@ -131,6 +131,11 @@ LbrSolid from_bytes(const std::vector<std::uint8_t>& bytes) {
   } else {
     sp.cylinder = CylinderStock{v[0], v[1], v[2], v[3], v[4]};
   }
+  // Every cell takes at least 4 bytes: a file too short for its grid is rejected before the
+  // grid is allocated.
+  if (static_cast<double>(levels) * sp.regions_x * sp.regions_y * 4.0 > static_cast<double>(r.left()))
+    r.fail("grid of " + std::to_string(levels) + " levels x " + std::to_string(sp.regions_x) + "x" +
+           std::to_string(sp.regions_y) + " regions does not fit in the file");
   LbrSolid solid = [&] {
     try {
       return LbrSolid(sp);
