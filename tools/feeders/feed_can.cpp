@@ -54,12 +54,15 @@ int main(int argc, char** argv) {
     addr.can_family = AF_CAN;
     addr.can_ifindex = ifr.ifr_ifindex;
     if (::bind(s, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) < 0) throw std::runtime_error(std::string("bind: ") + std::strerror(errno));
+    std::uint64_t send_errors = 0;  // e.g. ENETDOWN while the interface is down: counted, go on
     auto send = [&](const can_frame& fr) {
-      for (;;) {
+      for (int tries = 0; tries < 50; ++tries) {
         if (::write(s, &fr, sizeof(fr)) == static_cast<ssize_t>(sizeof(fr))) return true;
-        if (errno != ENOBUFS && errno != EAGAIN && errno != EINTR) return false;
+        if (errno != ENOBUFS && errno != EAGAIN && errno != EINTR) break;
         std::this_thread::sleep_for(std::chrono::microseconds(100));
       }
+      ++send_errors;
+      return true;
     };
     std::uint64_t syncs = 0, tpdos = 0, corrupted = 0, dropped = 0, duplicated = 0, k_tpdo = 0;
     if (priority > 0) (void)sched::configure_current_thread(sched::RtConfig{"lbr-feed", priority, -1, true});
@@ -101,7 +104,8 @@ int main(int argc, char** argv) {
     }
     ::close(s);
     nlohmann::json j{{"samples", stream.counts.size()}, {"syncs", syncs},   {"tpdos", tpdos},
-                     {"corrupted", corrupted},          {"dropped", dropped}, {"duplicated", duplicated}};
+                     {"corrupted", corrupted},          {"dropped", dropped}, {"duplicated", duplicated},
+                     {"send_errors", send_errors}};
     std::printf("%s\n", j.dump().c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "lbr-feed-can: error: %s\n", e.what());

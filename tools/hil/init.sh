@@ -18,7 +18,14 @@ i=0
 while ! grep -q vcan0 /proc/net/can/rcvlist_fil 2>/dev/null && [ $i -lt 600 ]; do sleep 0.1; i=$((i+1)); done
 sleep 0.5
 # The feeder plays the drives: highest priority, so its SYNC + TPDO bursts are not split.
-lbr-feed-can --priority 90 --profile /data/profile.toml --program /data/program.moves --iface vcan0 $FAULTS > /tmp/feed.json
+lbr-feed-can --priority 90 --profile /data/profile.toml --program /data/program.moves --iface vcan0 $FAULTS > /tmp/feed.json &
+FEED=$!
+# Interface down for a while in the middle: lbrsim must count it, reconnect and go on.
+sleep 1.5
+ip link set down vcan0
+sleep 0.4
+ip link set up vcan0
+wait $FEED
 sleep 1
 kill -INT $LBR
 wait $LBR
