@@ -24,6 +24,7 @@ using namespace lbr;
 
 struct BatchOptions {
   std::string program, profile, stock, regions, out = "lbrsim-out";
+  std::string stl, ply;  // mesh exports (empty: none)
   std::vector<std::string> tools;
   double level_spacing = 0.0;
   bool quiet = false;
@@ -52,6 +53,9 @@ int run_batch_command(const BatchOptions& o) {
               r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0, r.solid.levels(), r.solid.regions(),
               r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
   std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
+  app::write_mesh_files(r.solid, o.stl, o.ply);
+  if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
+  if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
   return 0;
 }
 
@@ -114,6 +118,8 @@ int main(int argc, char** argv) {
   batch->add_option("--regions", b.regions, "Region grid NXxNY (e.g. 4x4) or auto");
   batch->add_option("--out", b.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
   batch->add_flag("--quiet", b.quiet, "No progress messages");
+  batch->add_option("--stl", b.stl, "Also write the reconstructed part as binary STL to this file");
+  batch->add_option("--ply", b.ply, "Also write the reconstructed part as binary PLY (with normals, move id) to this file");
 
   RunOptions ro;
   CLI::App* run = cli.add_subcommand("run", "Simulate live from a machine (CAN, serial), a log replay or the emulator");

@@ -10,6 +10,8 @@
 
 #include "demo_program.inc"  // kDemoProgram
 #include "geom/serialize.hpp"
+#include "mesh/export.hpp"
+#include "mesh/reconstruct.hpp"
 #include "nc/movelist.hpp"
 
 namespace lbr::app {
@@ -72,6 +74,13 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
 
 void write_file(const std::string& path, const std::string& bytes) { write_bytes(path, bytes); }
 void write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) { write_bytes(path, bytes); }
+
+void write_mesh_files(const geom::LbrSolid& solid, const std::string& stl_path, const std::string& ply_path) {
+  if (stl_path.empty() && ply_path.empty()) return;
+  const std::vector<mesh::MeshBuffers> regions = mesh::reconstruct(solid);
+  if (!stl_path.empty()) write_file(stl_path, mesh::to_binary_stl(regions));
+  if (!ply_path.empty()) write_file(ply_path, mesh::to_binary_ply(regions));
+}
 
 void write_batch_outputs(const std::string& dir, const BatchResult& r, const Profile& profile,
                          const std::string& program) {

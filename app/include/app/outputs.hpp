@@ -26,6 +26,11 @@ namespace lbr::app {
 void write_batch_outputs(const std::string& dir, const BatchResult& r, const Profile& profile,
                          const std::string& program);
 
+// Reconstructs the whole part (mesh/, joined walls) and writes it as binary STL and/or PLY;
+// an empty path skips that format. For `lbrsim batch --stl/--ply` and live mode's export on
+// request. Throws std::runtime_error naming the path on I/O failure.
+void write_mesh_files(const geom::LbrSolid& solid, const std::string& stl_path, const std::string& ply_path);
+
 void write_file(const std::string& path, const std::string& bytes);
 void write_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
 

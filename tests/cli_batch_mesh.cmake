@@ -1,0 +1,23 @@
+# `lbrsim batch --stl --ply` on the built-in demo: both files exist and are well formed.
+file(REMOVE_RECURSE "${OUT}")
+execute_process(COMMAND "${LBRSIM}" batch --quiet --out "${OUT}" --stl "${OUT}/part.stl" --ply "${OUT}/part.ply"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "lbrsim batch --stl --ply failed (${rc}): ${out} ${err}")
+endif()
+file(SIZE "${OUT}/part.stl" stl_size)
+file(READ "${OUT}/part.stl" count_hex OFFSET 80 LIMIT 4 HEX)
+# little-endian uint32 triangle count
+string(SUBSTRING "${count_hex}" 0 2 b0)
+string(SUBSTRING "${count_hex}" 2 2 b1)
+string(SUBSTRING "${count_hex}" 4 2 b2)
+string(SUBSTRING "${count_hex}" 6 2 b3)
+math(EXPR tris "0x${b3}${b2}${b1}${b0}")
+math(EXPR expect "84 + 50 * ${tris}")
+if(NOT stl_size EQUAL expect OR tris LESS 1000)
+  message(FATAL_ERROR "part.stl: ${stl_size} bytes for ${tris} triangles (expected ${expect})")
+endif()
+file(READ "${OUT}/part.ply" head LIMIT 40)
+if(NOT head MATCHES "^ply\nformat binary_little_endian 1.0\n")
+  message(FATAL_ERROR "part.ply: bad header: ${head}")
+endif()
