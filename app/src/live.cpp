@@ -62,7 +62,10 @@ class RingSink final : public hal::SampleSink {
   void on_samples(std::span<const AxisSample> samples) noexcept override {
     for (const AxisSample& s : samples) {
       received_.store(received_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-      if (!validator_.accept(s, counters_)) continue;
+      if (!validator_.accept(s, counters_)) {
+        rejected_.store(rejected_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+        continue;
+      }
       if (backpressure_) {
         // Not a live source: wait for room rather than drop (never counts an overrun).
         while (ring_.size() >= ring_.capacity()) {
@@ -78,7 +81,7 @@ class RingSink final : public hal::SampleSink {
       rec_overruns_.store(rec_overruns_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   }
   [[nodiscard]] std::uint64_t received() const noexcept { return received_.load(std::memory_order_relaxed); }
-  [[nodiscard]] std::uint64_t rejected() const noexcept { return validator_.rejected(); }
+  [[nodiscard]] std::uint64_t rejected() const noexcept { return rejected_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t rec_overruns() const noexcept { return rec_overruns_.load(std::memory_order_relaxed); }
   [[nodiscard]] const hal::Counters& counters() const noexcept { return counters_; }
 
@@ -89,7 +92,7 @@ class RingSink final : public hal::SampleSink {
   bool backpressure_;
   const std::atomic<bool>& stop_;
   hal::Counters counters_;
-  std::atomic<std::uint64_t> received_{0}, rec_overruns_{0};
+  std::atomic<std::uint64_t> received_{0}, rejected_{0}, rec_overruns_{0};
 };
 
 // Geometry side: drains the ring, merges straight runs per channel, subtracts.
@@ -260,6 +263,7 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
 
   std::atomic<bool> hal_done{false}, rec_done{false};
   std::atomic<int> hal_mode{-1};
+  std::atomic<std::uint64_t> source_lost{0};
   const std::int64_t t0 = sched::now_ns();
 
   // Geometry thread: apply whatever is in the ring at once; when it was empty, look again
@@ -284,7 +288,10 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
   std::thread hal_thread([&] {
     hal_mode = sched::configure_current_thread(cfg.hal_thread) == sched::RtMode::Fifo ? 1 : 0;
     while (!stop.load(std::memory_order_relaxed)) {
-      if (src->poll(50, sink) == hal::PollResult::End) break;
+      const hal::PollResult pr = src->poll(50, sink);
+      source_lost.store(src->lost(), std::memory_order_relaxed);  // the source is this thread's
+      if (pr == hal::PollResult::End) break;
+      if (pr == hal::PollResult::Error) sched::sleep_until_ns(sched::now_ns() + 1'000'000);  // no busy loop
     }
     hal_done.store(true, std::memory_order_release);
   });
@@ -311,7 +318,7 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
     r.samples_rejected = sink.rejected();
     r.ring_overruns = ring.overruns();
     r.ring_high_water = ring.high_water();
-    r.samples_lost = src->lost() + r.samples_rejected + r.ring_overruns;
+    r.samples_lost = source_lost.load(std::memory_order_relaxed) + r.samples_rejected + r.ring_overruns;
     const auto& lag = geo.lag();
     r.lag_p50_ms = static_cast<double>(lag.percentile_ns(0.5)) * 1e-6;
     r.lag_p99_ms = static_cast<double>(lag.percentile_ns(0.99)) * 1e-6;
