@@ -97,24 +97,28 @@ TEST(LiveProfile, ErrorsNameLineAndKey) {
   EXPECT_NE(msg("[threads]\nhal_priority = 120\n").find("threads.hal_priority"), std::string::npos);
 }
 
-TEST(ToolpathSampler, SamplesAtTheFeed) {
+TEST(LiveRun, EmulatorWithToolChangesMatchesBatch) {
+  // Two tools: the emulator source reports the tool number, so each part cuts with its tool.
   const app::Profile p = app::default_profile();
-  nc::Toolpath path = nc::parse_movelist(kShortProgram, "short");
-  app::ToolpathSampler s(p, path, 0.001);
-  nc::AxisVector q{};
-  ASSERT_TRUE(s.next(q));
-  EXPECT_DOUBLE_EQ(q[0], 10.0);  // start
-  EXPECT_DOUBLE_EQ(q[2], 5.0);
-  int n = 1;
-  nc::AxisVector last{};
-  while (s.next(q)) {
-    last = q;
-    ++n;
-  }
-  EXPECT_DOUBLE_EQ(last[0], 20.0);
-  EXPECT_DOUBLE_EQ(last[2], -1.0);
-  const double t = app::machining_time_s(p, path);
-  EXPECT_NEAR(n, t / 0.001 + 2, 2.0);  // one sample per ms plus start and end samples
+  const std::string program = std::string(kShortProgram) + "rapid 20 30 5\ntool 2\nrapid 30 60 5\nline 30 60 -2\nline 80 60 -2\nrapid 80 60 5\n";
+  const std::string dir = testing::TempDir() + "/lbr_live_emu";
+  std::filesystem::create_directories(dir);
+  const std::string file = dir + "/two-tools.moves";
+  std::ofstream(file) << program;
+  std::atomic<bool> stop{false};
+  app::LiveOptions o;
+  o.source = "emulator:" + file;
+  o.speed = 0.0;
+  const app::LiveResult r = app::run_live(p, o, stop);
+  const nc::Toolpath path = nc::parse_movelist(program, "two-tools");
+  const app::BatchResult b = app::run_batch(p, path);
+  EXPECT_EQ(r.samples_lost, 0u);
+  EXPECT_EQ(r.samples_applied, r.samples_received);
+  const nc::Emulator emu(path, app::live_emulator_limits(p));
+  EXPECT_EQ(r.samples_received, emu.sample_count());
+  EXPECT_NEAR(r.removed_volume_mm3, b.removed_volume_mm3, 5e-4 * b.removed_volume_mm3);
+  // With tool 1 only (live.tool, no tool numbers) the ball-nose groove would be a flat one.
+  EXPECT_GT(b.removed_volume_mm3, 100.0);
 }
 
 TEST(LiveRun, CandumpReplayWithFaultsMatchesBatch) {
@@ -127,13 +131,16 @@ TEST(LiveRun, CandumpReplayWithFaultsMatchesBatch) {
   std::uint64_t cycles = 0;
   {
     std::ofstream out(log);
-    app::ToolpathSampler s(p, path, 0.001);
-    nc::AxisVector q{};
+    nc::Emulator emu(path, app::live_emulator_limits(p));
+    nc::Sample smp;
+    smp.axes = path.start;
     std::int64_t t = 1'700'000'000'000'000'000LL;
     int counter = 0;
     char line[128];
     auto put = [&](const hal::CanFrame& f) { out.write(line, static_cast<std::streamsize>(hal::format_candump_line(f, "vcan0", line))); };
-    while (s.next(q)) {
+    bool more = true;
+    for (; more; more = emu.next(smp)) {
+      const nc::AxisVector& q = smp.axes;
       ++cycles;
       hal::CanFrame sy;
       sy.id = 0x080;

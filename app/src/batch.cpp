@@ -41,7 +41,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
   std::map<int, geom::CutterShape> shapes;
   for (const nc::Segment& s : path.segments) {
     if (s.kind != nc::SegmentKind::Rapid && s.kind != nc::SegmentKind::Feed && s.kind != nc::SegmentKind::ToolChange) continue;
-    if (shapes.count(s.tool)) continue;
+    if (s.tool == 0 || shapes.count(s.tool)) continue;  // tool 0: empty spindle
     const auto it = profile.tools.find(s.tool);
     if (it == profile.tools.end())
       throw std::runtime_error(path.source + ":" + std::to_string(s.line) + ": tool " + std::to_string(s.tool) +
@@ -70,6 +70,10 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
     if (s.kind != nc::SegmentKind::Rapid && s.kind != nc::SegmentKind::Feed) continue;
     geom::Pose next = pose_of(s.end, s.tool_axis);
     if (!s.has_tool_axis) next.axis = pose.axis;
+    if (s.tool == 0) {  // no tool in the spindle (e.g. G28 before the first M6): nothing cuts
+      pose = next;
+      continue;
+    }
     batch.push_back({&shapes.at(s.tool), pose, next, static_cast<geom::MoveId>(i + 1)});
     pose = next;
     ++r.moves;

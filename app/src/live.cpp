@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -26,14 +27,20 @@ namespace {
 
 using hal::AxisSample;
 
-// ---- emulator source: a tool path sampled at the profile's period ----
-class SamplerGenerator final : public hal::SampleGenerator {
+// ---- emulator source: the nc machine emulator at the live sample period ----
+class EmulatorGenerator final : public hal::SampleGenerator {
  public:
-  explicit SamplerGenerator(std::unique_ptr<ToolpathSampler> s) : s_(std::move(s)) {}
-  bool next(std::array<double, hal::kMaxAxes>& q) noexcept override { return s_->next(q); }
+  EmulatorGenerator(const nc::Toolpath& path, const nc::EmulatorLimits& limits) : emu_(path, limits) {}
+  bool next(std::array<double, hal::kMaxAxes>& q, int& tool) noexcept override {
+    nc::Sample s;
+    if (!emu_.next(s)) return false;
+    for (std::size_t a = 0; a < q.size(); ++a) q[a] = s.axes[a];
+    tool = s.tool;
+    return true;
+  }
 
  private:
-  std::unique_ptr<ToolpathSampler> s_;
+  nc::Emulator emu_;
 };
 
 std::unique_ptr<hal::Source> make_source(const Profile& profile, const LiveOptions& opt) {
@@ -45,9 +52,13 @@ std::unique_ptr<hal::Source> make_source(const Profile& profile, const LiveOptio
   if (kind == "serial") return hal::make_serial_source(arg, profile.live);
   if (kind == "replay") return hal::make_replay_source(arg, profile.live, opt.speed);
   if (kind == "emulator") {
-    nc::Toolpath path = arg == "demo" ? demo_toolpath() : load_toolpath(arg, profile);
-    auto sampler = std::make_unique<ToolpathSampler>(profile, std::move(path), profile.live.period_ms * 1e-3);
-    return hal::make_generator_source(std::make_unique<SamplerGenerator>(std::move(sampler)), arg, profile.live, opt.speed);
+    const nc::Toolpath path = arg == "demo" ? demo_toolpath() : load_toolpath(arg, profile);
+    for (const nc::Segment& sg : path.segments)
+      if (sg.tool != 0 && !profile.tools.count(sg.tool))
+        throw std::runtime_error(path.source + ":" + std::to_string(sg.line) + ": tool " + std::to_string(sg.tool) +
+                                 " is not in the tool table of " + profile.source);
+    return hal::make_generator_source(std::make_unique<EmulatorGenerator>(path, live_emulator_limits(profile)), arg,
+                                      profile.live, opt.speed);
   }
   throw std::runtime_error("--source '" + opt.source + "': unknown kind '" + kind + "' (can, serial, replay, emulator)");
 }
@@ -100,8 +111,13 @@ class Geometry {
  public:
   static constexpr std::size_t kMaxRun = 256;
 
-  Geometry(geom::LbrSolid& solid, const geom::CutterShape& shape, sched::SpscRing<AxisSample>& ring, double tol_mm)
-      : solid_(solid), shape_(shape), ring_(ring), tol_(tol_mm) {
+  // `shapes`: every tool of the profile; `default_tool` cuts for samples without a tool
+  // number. Tool numbers without a shape (0 = empty spindle) cut nothing.
+  Geometry(geom::LbrSolid& solid, const std::map<int, geom::CutterShape>& shapes, int default_tool,
+           sched::SpscRing<AxisSample>& ring, double tol_mm)
+      : solid_(solid), shapes_(shapes), ring_(ring), tol_(tol_mm) {
+    const auto it = shapes_.find(default_tool);
+    default_shape_ = it == shapes_.end() ? nullptr : &it->second;
     const std::size_t cap = ring.capacity();
     batch_.reserve(cap + hal::kMaxChannels);
     rx_.resize(cap);
@@ -149,6 +165,7 @@ class Geometry {
   struct Channel {
     bool have = false;
     geom::Vec3 last{};               // latest position (end of the pending run)
+    const geom::CutterShape* shape = nullptr;  // tool of the pending run (nullptr: cuts nothing)
     std::vector<geom::Vec3> run;     // run[0] = start of the pending sweep, then its samples
     std::uint64_t seq = 0;
   };
@@ -169,8 +186,18 @@ class Geometry {
     if (s.mask & 2U) p.y = s.q[1];
     if (s.mask & 4U) p.z = s.q[2];
     c.seq = s.seq;
+    const geom::CutterShape* shape = default_shape_;
+    if (s.tool >= 0) {
+      const auto it = shapes_.find(s.tool);  // no allocation
+      shape = it == shapes_.end() ? nullptr : &it->second;
+    }
+    if (c.have && shape != c.shape) {  // tool change: the pending run belongs to the old tool
+      flush(c);
+      c.shape = shape;
+    }
     if (!c.have) {  // first sample: where the tool is; nothing to cut yet
       c.have = true;
+      c.shape = shape;
       c.last = p;
       c.run.clear();
       c.run.push_back(p);
@@ -192,14 +219,15 @@ class Geometry {
   void flush(Channel& c) noexcept {
     if (c.run.size() < 2) return;
     geom::Pose from{c.run.front(), {0, 0, 1}}, to{c.run.back(), {0, 0, 1}};
-    batch_.push_back({&shape_, from, to, static_cast<geom::MoveId>(c.seq & 0xFFFFFFFFU)});
+    if (c.shape != nullptr) batch_.push_back({c.shape, from, to, static_cast<geom::MoveId>(c.seq & 0xFFFFFFFFU)});
     const geom::Vec3 end = c.run.back();
     c.run.clear();
     c.run.push_back(end);
   }
 
   geom::LbrSolid& solid_;
-  const geom::CutterShape& shape_;
+  const std::map<int, geom::CutterShape>& shapes_;
+  const geom::CutterShape* default_shape_ = nullptr;
   sched::SpscRing<AxisSample>& ring_;
   double tol_;
   geom::SubtractWorkspace ws_;
@@ -236,9 +264,14 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
   const auto tool = profile.tools.find(cfg.tool);
   if (tool == profile.tools.end())
     throw std::runtime_error(profile.source + ": live.tool " + std::to_string(cfg.tool) + " is not in the tool table");
-  const geom::CutterShape shape = geom::CutterShape::build(tool->second, profile.solid.chord_tol_mm);
+  std::map<int, geom::CutterShape> shapes;
+  double dmax = 1.0;
+  for (const auto& [n, t] : profile.tools) {
+    shapes.emplace(n, geom::CutterShape::build(t, profile.solid.chord_tol_mm));
+    dmax = std::max(dmax, t.diameter_mm);
+  }
   geom::SolidSpec spec = profile.solid;
-  if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tool->second.diameter_mm);
+  if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, dmax);
   LiveResult r{geom::LbrSolid(spec), opt.source, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, {}, 0, 0, 0, 0, 0, 0, ""};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
 
@@ -259,7 +292,7 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
   if (opt.source.rfind("can:", 0) == 0) rec_iface = opt.source.substr(4);
 
   RingSink sink(ring, rec_ring.get(), cfg, backpressure, stop);
-  Geometry geo(r.solid, shape, ring, cfg.merge_tolerance_mm);
+  Geometry geo(r.solid, shapes, cfg.tool, ring, cfg.merge_tolerance_mm);
 
   std::atomic<bool> hal_done{false}, rec_done{false};
   std::atomic<int> hal_mode{-1};
@@ -398,50 +431,10 @@ void write_live_outputs(const std::string& dir, const LiveResult& r, const Profi
   write_file(dir + "/levels.lbrs", geom::to_bytes(r.solid));
 }
 
-// ---- ToolpathSampler ----
-
-ToolpathSampler::ToolpathSampler(const Profile& profile, nc::Toolpath path, double period_s)
-    : path_(std::move(path)), rapid_(profile.rapid_mm_per_min), period_s_(period_s) {
-  if (!(period_s > 0)) throw std::invalid_argument("sample period must be > 0");
-  from_ = path_.start;
-}
-
-bool ToolpathSampler::next(nc::AxisVector& q) noexcept {
-  if (done_) return false;
-  if (!started_) {  // the first sample is the start position
-    started_ = true;
-    q = from_;
-    return true;
-  }
-  double remaining = period_s_;
-  while (seg_ < path_.segments.size()) {
-    const nc::Segment& s = path_.segments[seg_];
-    double dur = 0.0, len = 0.0;
-    if (s.kind == nc::SegmentKind::Rapid || s.kind == nc::SegmentKind::Feed) {
-      len = std::hypot(s.end[0] - from_[0], s.end[1] - from_[1], s.end[2] - from_[2]);
-      const double f = s.kind == nc::SegmentKind::Rapid ? rapid_ : s.feed_mm_per_min;
-      dur = f > 0 ? len / f * 60.0 : 0.0;
-    } else if (s.kind == nc::SegmentKind::Dwell) {
-      dur = s.dwell_s;
-    }
-    if (t_in_seg_ + remaining < dur) {
-      t_in_seg_ += remaining;
-      const double u = t_in_seg_ / dur;
-      for (int a = 0; a < nc::kAxes; ++a)
-        q[static_cast<std::size_t>(a)] = (s.kind == nc::SegmentKind::Dwell) ? from_[static_cast<std::size_t>(a)]
-                                                                          : from_[static_cast<std::size_t>(a)] +
-                                                                                u * (s.end[static_cast<std::size_t>(a)] - from_[static_cast<std::size_t>(a)]);
-      return true;
-    }
-    remaining -= dur - t_in_seg_;
-    t_in_seg_ = 0.0;
-    if (s.kind == nc::SegmentKind::Rapid || s.kind == nc::SegmentKind::Feed) from_ = s.end;
-    ++seg_;
-  }
-  // End of program: one last sample at the final position.
-  done_ = true;
-  q = from_;
-  return true;
+nc::EmulatorLimits live_emulator_limits(const Profile& profile) {
+  nc::EmulatorLimits l = emulator_limits(profile);
+  l.sample_period_ms = profile.live.period_ms;
+  return l;
 }
 
 }  // namespace lbr::app

@@ -1,7 +1,8 @@
-// lbrsim — command-line entry point. Subcommands: batch, run, profile.
+// lbrsim — command-line entry point. Subcommands: batch, run, emulate, profile.
+#include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <atomic>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
+#include "nc/emulator.hpp"
 
 #ifndef LBRSIM_VERSION
 #define LBRSIM_VERSION "dev"
@@ -23,12 +25,52 @@ namespace {
 using namespace lbr;
 
 struct BatchOptions {
-  std::string program, profile, stock, regions, out = "lbrsim-out";
+  std::string program, profile, stock, regions, out = "lbrsim-out", interpreter = "builtin";
   std::string stl, ply;  // mesh exports (empty: none)
   std::vector<std::string> tools;
   double level_spacing = 0.0;
   bool quiet = false;
+  bool sampled = false;
 };
+
+struct EmulateOptions {
+  std::string program, profile, period, out = "samples.csv", interpreter = "builtin";
+};
+
+app::Interpreter interpreter_of(const std::string& s) {
+  return s == "rs274" ? app::Interpreter::Rs274 : app::Interpreter::Builtin;
+}
+
+// "4ms", "4", "500us", "0.004s" -> milliseconds.
+double parse_period_ms(const std::string& s) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const std::string unit = used > 0 ? s.substr(used) : "";
+  double ms = v;
+  if (unit == "us") ms = v * 1e-3;
+  else if (unit == "s") ms = v * 1e3;
+  else if (!(unit.empty() || unit == "ms")) used = 0;
+  if (used == 0 || !std::isfinite(ms) || ms < 0.1 || ms > 1000.0)
+    throw std::runtime_error("--period " + s + ": expected a period between 0.1 ms and 1000 ms, e.g. 4ms, 500us");
+  return ms;
+}
+
+int run_emulate_command(const EmulateOptions& o) {
+  app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+  if (!o.period.empty()) profile.sample_period_ms = parse_period_ms(o.period);
+  const nc::Toolpath path = app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
+  nc::Emulator em(path, app::emulator_limits(profile));
+  const std::uint64_t n = app::write_samples_csv(o.out, em);
+  std::printf("%llu samples every %.4g ms | machining %.3f s | %zu segments | wrote %s\n",
+              static_cast<unsigned long long>(n), profile.sample_period_ms, em.total_time_s(), path.segments.size(),
+              o.out.c_str());
+  return 0;
+}
 
 int run_batch_command(const BatchOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
@@ -37,15 +79,28 @@ int run_batch_command(const BatchOptions& o) {
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
 
-  const nc::Toolpath path = o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile);
+  nc::Toolpath path =
+      o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   const std::string program = o.program.empty() ? path.source : o.program;
   spdlog::info("program {} ({} segments), profile {}", program, path.segments.size(), profile.source);
+  // G-code programs and sampled runs take the emulator's time (acceleration, axis limits).
+  const bool emulated = o.sampled || (!o.program.empty() && app::is_gcode_path(o.program));
+  double emulated_time_s = 0.0;
+  if (emulated) {
+    const nc::EmulatorLimits limits = app::emulator_limits(profile);
+    emulated_time_s = nc::emulated_time_s(path, limits);
+    if (o.sampled) {
+      path = nc::sampled_toolpath(path, limits);
+      spdlog::info("sampled every {} ms: {} segments", profile.sample_period_ms, path.segments.size());
+    }
+  }
 
   app::Progress progress;
   if (!o.quiet) {
     progress = [](double f) { spdlog::info("progress {:5.1f} %", 100.0 * f); };
   }
-  const app::BatchResult r = app::run_batch(profile, path, progress);
+  app::BatchResult r = app::run_batch(profile, path, progress);
+  if (emulated) r.machining_time_s = emulated_time_s;
   app::write_batch_outputs(o.out, r, profile, program);
   std::printf("removed %.3f mm3 of %.3f mm3 | machining %.2f s | simulated in %.3f s (factor %.5f) | "
               "%d levels x %d regions (%dx%d), %zu vertices\n",
@@ -106,7 +161,15 @@ int main(int argc, char** argv) {
   BatchOptions b;
   CLI::App* batch = cli.add_subcommand("batch", "Run a part program through the simulator as fast as possible");
   batch->add_option("--program", b.program,
-                    "Part program: a move list (.moves); without it the bundled demo program runs");
+                    "Part program: a move list (.moves) or G-code (.ngc, .nc, .gcode, .tap); without it the "
+                    "bundled demo program runs");
+  batch->add_option("--interpreter", b.interpreter,
+                    "G-code front end: builtin, or rs274 (LinuxCNC's interpreter, package linuxcnc-uspace)")
+      ->check(CLI::IsMember({"builtin", "rs274"}))
+      ->capture_default_str();
+  batch->add_flag("--sampled", b.sampled,
+                  "Run the kernel on the machine emulator's sampled stream (as live mode sees it) instead of the "
+                  "interpreted segments");
   batch->add_option("--profile", b.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
   batch->add_option("--stock", b.stock,
                     "Override the stock: box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX or cylinder:DIAMETER,ZMIN,ZMAX [mm]");
@@ -134,6 +197,16 @@ int main(int argc, char** argv) {
   run->add_option("--record", ro.live.record, "Record the raw input to this file (candump -l format)");
   run->add_flag("--quiet", ro.quiet, "No status lines");
 
+  EmulateOptions em;
+  CLI::App* emu = cli.add_subcommand("emulate", "Run a part program through the machine emulator and write its samples");
+  emu->add_option("program", em.program, "Part program (G-code or .moves)")->required();
+  emu->add_option("--profile", em.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
+  emu->add_option("--period", em.period, "Sample period, e.g. 4ms, 500us (default: the profile's sample_period_ms)");
+  emu->add_option("--out", em.out, "CSV file (columns: docs/nc-frontend.md#samples-csv)")->capture_default_str();
+  emu->add_option("--interpreter", em.interpreter, "G-code front end: builtin or rs274")
+      ->check(CLI::IsMember({"builtin", "rs274"}))
+      ->capture_default_str();
+
   std::string check_path;
   bool print_default = false;
   CLI::App* prof = cli.add_subcommand("profile", "Check a profile, or print the built-in default profile");
@@ -147,6 +220,7 @@ int main(int argc, char** argv) {
   try {
     if (batch->parsed()) return run_batch_command(b);
     if (run->parsed()) return run_live_command(ro);
+    if (emu->parsed()) return run_emulate_command(em);
     if (prof->parsed()) {
       if (print_default) {
         std::cout << app::default_profile_text();

@@ -1,6 +1,7 @@
 #include "app/outputs.hpp"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -12,7 +13,9 @@
 #include "geom/serialize.hpp"
 #include "mesh/export.hpp"
 #include "mesh/reconstruct.hpp"
+#include "nc/gcode.hpp"
 #include "nc/movelist.hpp"
+#include "nc/rs274.hpp"
 
 namespace lbr::app {
 
@@ -35,12 +38,22 @@ void write_bytes(const std::string& path, const Bytes& bytes) {
 
 }  // namespace
 
-nc::Toolpath load_toolpath(const std::string& path, const Profile& /*profile*/) {
+bool is_gcode_path(const std::string& path) {
   const std::string ext = extension(path);
-  if (ext == ".moves") return nc::load_movelist(path);
-  if (ext == ".ngc" || ext == ".nc" || ext == ".gcode" || ext == ".tap")
-    throw std::runtime_error(path + ": G-code programs need the NC front end, which this build does not have yet; "
-                             "use a move list (.moves, docs/formats.md)");
+  return ext == ".ngc" || ext == ".nc" || ext == ".gcode" || ext == ".tap";
+}
+
+nc::Toolpath load_toolpath(const std::string& path, const Profile& profile, Interpreter interpreter) {
+  const std::string ext = extension(path);
+  if (ext == ".moves") {
+    if (interpreter == Interpreter::Rs274)
+      throw std::runtime_error(path + ": --interpreter rs274 applies to G-code programs, not move lists");
+    return nc::load_movelist(path);
+  }
+  if (is_gcode_path(path)) {
+    const nc::GcodeOptions o = gcode_options(profile);
+    return interpreter == Interpreter::Rs274 ? nc::run_rs274(path, o) : nc::load_gcode(path, o);
+  }
   throw std::runtime_error(path + ": unknown program type '" + ext + "' (expected .moves, .ngc, .nc, .gcode or .tap)");
 }
 
@@ -70,6 +83,26 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
   j["cells_changed"] = r.stats.cells_changed;
   j["peak_rss_mb"] = peak_rss_mb();
   return j.dump(2) + "\n";
+}
+
+std::uint64_t write_samples_csv(const std::string& path, nc::Emulator& em) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) throw std::runtime_error(path + ": cannot open for writing: " + std::strerror(errno));
+  f << "seq,t_s,tool,x_mm,y_mm,z_mm,a_deg,b_deg,c_deg\n";
+  em.reset();
+  nc::Sample s;
+  std::uint64_t n = 0;
+  char line[256];
+  while (em.next(s)) {
+    const int len = std::snprintf(line, sizeof line, "%llu,%.6f,%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n",
+                                  static_cast<unsigned long long>(s.seq), s.t_s, s.tool, s.axes[0], s.axes[1],
+                                  s.axes[2], s.axes[3], s.axes[4], s.axes[5]);
+    f.write(line, len);
+    ++n;
+  }
+  f.close();
+  if (!f) throw std::runtime_error(path + ": write failed: " + std::strerror(errno));
+  return n;
 }
 
 void write_file(const std::string& path, const std::string& bytes) { write_bytes(path, bytes); }

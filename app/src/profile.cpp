@@ -274,6 +274,26 @@ Profile parse_profile(const std::string& text, const std::string& name) {
       s.fail(m->get("kind"), "kind", "expected \"mill3\" (other machine kinds are not supported yet), got '" + p.machine_kind + "'");
     p.rapid_mm_per_min = s.number("rapid_mm_per_min", 15000.0, 1.0, 1e6, "mm/min");
     p.tool_change_s = s.number("tool_change_s", 0.0, 0.0, 3600.0, "s");
+    auto triple = [&](const char* key, std::array<double, 3>& out, double lo, double hi, const char* unit) {
+      if (m->get(key) == nullptr) {
+        s.get(key);
+        return;
+      }
+      const auto v = s.numbers(key, 3, unit);
+      for (std::size_t i = 0; i < 3; ++i) {
+        if (v[i] < lo || v[i] > hi) {
+          std::ostringstream msg;
+          msg << "expected numbers in [" << lo << ", " << hi << "] " << unit << ", got " << v[i];
+          s.fail(m->get(key), key, msg.str());
+        }
+        out[i] = v[i];
+      }
+    };
+    triple("max_velocity_mm_per_min", p.max_velocity_mm_per_min, 1.0, 1e6, "mm/min");
+    triple("max_accel_mm_per_s2", p.max_accel_mm_per_s2, 1.0, 1e6, "mm/s2");
+    triple("g54_origin_mm", p.g54_origin_mm, -1e5, 1e5, "mm");
+    p.max_feed_mm_per_min = s.number("max_feed_mm_per_min", 0.0, 0.0, 1e6, "mm/min");
+    p.sample_period_ms = s.number("sample_period_ms", 4.0, 0.1, 1000.0, "ms");
     s.reject_unknown();
   }
 
@@ -347,6 +367,31 @@ Profile load_profile(const std::string& path) {
 const char* default_profile_text() noexcept { return kDefaultProfileToml; }
 
 Profile default_profile() { return parse_profile(kDefaultProfileToml, "<built-in default-mill3>"); }
+
+nc::GcodeOptions gcode_options(const Profile& p) {
+  nc::GcodeOptions o;
+  o.machine = nc::MachineKind::Mill3;  // the only kind profiles accept so far
+  for (const auto& [n, t] : p.tools) {
+    o.tool_lengths[n] = t.length_mm;
+    o.tool_diameters[n] = t.diameter_mm;
+  }
+  o.chord_tol_mm = p.solid.chord_tol_mm;
+  for (int a = 0; a < 3; ++a) o.work_offsets[0][a] = p.g54_origin_mm[static_cast<std::size_t>(a)];
+  return o;
+}
+
+nc::EmulatorLimits emulator_limits(const Profile& p) {
+  nc::EmulatorLimits l;
+  l.rapid_mm_per_min = p.rapid_mm_per_min;
+  l.max_feed_mm_per_min = p.max_feed_mm_per_min;
+  for (std::size_t a = 0; a < 3; ++a) {
+    l.max_velocity[a] = p.max_velocity_mm_per_min[a] > 0 ? p.max_velocity_mm_per_min[a] : p.rapid_mm_per_min;
+    l.max_accel[a] = p.max_accel_mm_per_s2[a];
+  }
+  l.sample_period_ms = p.sample_period_ms;
+  l.tool_change_s = p.tool_change_s;
+  return l;
+}
 
 std::pair<int, int> auto_region_grid(const geom::SolidSpec& solid, double max_tool_diameter_mm) {
   double wx, wy;

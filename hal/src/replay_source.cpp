@@ -162,10 +162,12 @@ class GeneratorSource final : public Source {
       next_t_ += static_cast<std::int64_t>(static_cast<double>(period_ns_) / speed_);
     }
     AxisSample s;
-    if (!gen_->next(s.q)) {
+    int tool = -1;
+    if (!gen_->next(s.q, tool)) {
       done_ = true;
       return PollResult::End;
     }
+    s.tool = static_cast<std::int16_t>(tool < -1 || tool > 32767 ? -1 : tool);
     s.seq = ++seq_;
     s.mask = 0b111111;
     s.t_rx_ns = sched::now_ns();

@@ -1,5 +1,6 @@
 // tools/feeders/feed_common.hpp — shared parts of the feeders: the sample stream of a
-// program (profile period, counts per the profile mapping) and seeded fault injection.
+// program (nc machine emulator at live.period_ms, counts per the profile mapping) and
+// seeded fault injection.
 #pragma once
 
 #include <cmath>
@@ -37,15 +38,17 @@ inline std::int32_t to_counts(const hal::AxisMap& m, double v) {
 
 inline Stream make_stream(const app::Profile& profile, const std::string& program) {
   nc::Toolpath path = program.empty() || program == "demo" ? app::demo_toolpath() : app::load_toolpath(program, profile);
-  app::ToolpathSampler sampler(profile, std::move(path), profile.live.period_ms * 1e-3);
+  nc::Emulator emu(path, app::live_emulator_limits(profile));
   Stream s;
   s.period_s = profile.live.period_ms * 1e-3;
-  nc::AxisVector q{};
-  while (sampler.next(q)) {
+  // The first sample: the machine at its start position, before it moves.
+  nc::Sample smp;
+  smp.axes = path.start;
+  do {
     std::vector<std::int32_t> row;
-    for (const hal::AxisMap& m : profile.live.axes) row.push_back(to_counts(m, q[static_cast<std::size_t>(m.axis)]));
+    for (const hal::AxisMap& m : profile.live.axes) row.push_back(to_counts(m, smp.axes[static_cast<std::size_t>(m.axis)]));
     s.counts.push_back(std::move(row));
-  }
+  } while (emu.next(smp));
   return s;
 }
 

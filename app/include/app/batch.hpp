@@ -15,7 +15,8 @@ struct BatchResult {
   geom::LbrSolid solid;
   double stock_volume_mm3 = 0;
   double removed_volume_mm3 = 0;
-  double machining_time_s = 0;  // from feeds, rapid rate, dwells and tool changes
+  double machining_time_s = 0;  // time the machine needs: the simple model below; lbrsim batch
+                                // replaces it by the emulator's time for G-code and --sampled
   double wall_time_s = 0;       // kernel time only (excluding parsing and output)
   std::uint64_t moves = 0;      // motion segments
   geom::SubtractStats stats;
@@ -25,7 +26,8 @@ struct BatchResult {
 using Progress = std::function<void(double)>;
 
 // Runs `path` on the stock of `profile`. Throws std::runtime_error naming the source line
-// when the path uses a tool the profile does not define.
+// when the path uses a tool the profile does not define. Segments with tool 0 (empty
+// spindle) remove nothing.
 [[nodiscard]] BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress = {});
 
 // Machining time [s] of a tool path under the simple motion model of the batch runner

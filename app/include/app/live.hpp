@@ -1,6 +1,7 @@
 // app/live.hpp — `lbrsim run`: the live pipeline.
 //
 //   HAL thread (RT, highest)  source.poll → validate → SpscRing<AxisSample>.try_push
+//                             (emulator:PROGRAM = nc::Emulator at live.period_ms, with tool numbers)
 //   geometry thread (RT)      drain the ring as soon as it holds samples, merge straight runs
 //                             of samples per channel into sweeps, LbrSolid::subtract(batch),
 //                             record lag = done − receive time of every applied sample
@@ -17,6 +18,7 @@
 
 #include "app/profile.hpp"
 #include "geom/lbr_solid.hpp"
+#include "nc/emulator.hpp"
 #include "nc/toolpath.hpp"
 
 namespace lbr::app {
@@ -58,23 +60,9 @@ using StatusFn = std::function<void(const std::string& line)>;
 [[nodiscard]] std::string live_metrics_json(const LiveResult& r, const Profile& profile);
 void write_live_outputs(const std::string& dir, const LiveResult& r, const Profile& profile);
 
-// Constant-feed sampler of a tool path (feeds, rapid rate, dwells; no acceleration): the
-// position every period_s, starting at the path start. Used by the emulator source and
-// the feeders until the nc machine emulator is wired in. next() is RT-safe.
-class ToolpathSampler {
- public:
-  ToolpathSampler(const Profile& profile, nc::Toolpath path, double period_s);
-  bool next(nc::AxisVector& q) noexcept;
-  [[nodiscard]] const nc::Toolpath& path() const noexcept { return path_; }
-
- private:
-  nc::Toolpath path_;
-  double rapid_;
-  double period_s_;
-  std::size_t seg_ = 0;
-  double t_in_seg_ = 0;  // [s] into the current segment
-  nc::AxisVector from_{};
-  bool started_ = false, done_ = false;
-};
+// The machine emulator (nc/emulator.hpp) for live mode: the profile's motion limits with
+// the live sample period (live.period_ms), so emulator and feeders stream what a machine
+// reporting at that period would. Setup; throws like nc::Emulator.
+[[nodiscard]] nc::EmulatorLimits live_emulator_limits(const Profile& profile);
 
 }  // namespace lbr::app

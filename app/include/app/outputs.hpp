@@ -11,10 +11,21 @@
 
 namespace lbr::app {
 
+// G-code front ends: the built-in interpreter or LinuxCNC's rs274 (nc/rs274.hpp).
+enum class Interpreter { Builtin, Rs274 };
+
+// True for the G-code file extensions (.ngc, .nc, .gcode, .tap; any case).
+[[nodiscard]] bool is_gcode_path(const std::string& path);
+
 // Loads a tool path, choosing the front end by file extension (.moves; G-code: .ngc, .nc,
-// .gcode, .tap). `profile` supplies the tool table. Throws nc::ParseError or
-// std::runtime_error with file and line.
-[[nodiscard]] nc::Toolpath load_toolpath(const std::string& path, const Profile& profile);
+// .gcode, .tap, through `interpreter`). `profile` supplies the tool table, chord tolerance
+// and G54 origin. Throws nc::ParseError or std::runtime_error with file and line.
+[[nodiscard]] nc::Toolpath load_toolpath(const std::string& path, const Profile& profile,
+                                         Interpreter interpreter = Interpreter::Builtin);
+
+// Writes emulator samples as CSV (columns in docs/nc-frontend.md#samples-csv). Returns the
+// number of samples. Throws std::runtime_error naming the path on I/O failure.
+std::uint64_t write_samples_csv(const std::string& path, nc::Emulator& emulator);
 // The bundled demo part program (config/programs/demo-pocket.moves, compiled in).
 [[nodiscard]] nc::Toolpath demo_toolpath();
 

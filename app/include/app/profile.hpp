@@ -9,6 +9,8 @@
 #include "geom/lbr_solid.hpp"
 #include "geom/tool.hpp"
 #include "hal/config.hpp"
+#include "nc/emulator.hpp"
+#include "nc/gcode.hpp"
 
 namespace lbr::app {
 
@@ -23,6 +25,12 @@ struct Profile {
   std::string machine_kind = "mill3";
   double rapid_mm_per_min = 15000.0;
   double tool_change_s = 0.0;
+  // Machine emulator and G-code frames ([machine] keys in docs/profiles.md).
+  std::array<double, 3> max_velocity_mm_per_min{0, 0, 0};  // per axis X Y Z; 0: the rapid rate
+  std::array<double, 3> max_accel_mm_per_s2{1000, 1000, 1000};  // per axis X Y Z
+  double max_feed_mm_per_min = 0.0;   // cap on programmed feeds; 0: none
+  double sample_period_ms = 4.0;      // emulator sample period
+  std::array<double, 3> g54_origin_mm{0, 0, 0};  // machine coordinates of the G54 origin
   geom::SolidSpec solid;    // stock, Δ, region grid, chord tolerance
   bool regions_auto = false;
   int batch_moves = 64;     // moves per subtract() call in batch mode
@@ -36,6 +44,11 @@ struct Profile {
 // The built-in default 3-axis mill profile (config/profiles/default-mill3.toml, compiled in).
 [[nodiscard]] Profile default_profile();
 [[nodiscard]] const char* default_profile_text() noexcept;
+
+// Interpreter options from a profile: tool lengths, machine kind, chord tolerance, G54 origin.
+[[nodiscard]] nc::GcodeOptions gcode_options(const Profile& p);
+// Emulator limits from a profile (axis limits, rapid rate, sample period, tool change time).
+[[nodiscard]] nc::EmulatorLimits emulator_limits(const Profile& p);
 
 // Region grid for regions = "auto": an interim rule from stock size and tool diameter
 // (docs/profiles.md). Returns {nx, ny}.

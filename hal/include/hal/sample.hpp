@@ -18,6 +18,7 @@ struct AxisSample {
   std::int64_t t_src_ns = 0;     // sender timestamp [ns] (serial) or SYNC time (CAN)
   std::uint8_t channel = 0;
   std::uint8_t mask = 0;         // bit a set: q[a] holds a value
+  std::int16_t tool = -1;        // tool in the spindle when the source knows it (emulator); -1: not reported
   std::array<double, kMaxAxes> q{};  // X Y Z [mm], A B C [deg]
 };
 

@@ -70,7 +70,8 @@ class Source {
 class SampleGenerator {
  public:
   virtual ~SampleGenerator() = default;
-  virtual bool next(std::array<double, kMaxAxes>& q) noexcept = 0;
+  // Next position and the tool in the spindle (-1 if unknown).
+  virtual bool next(std::array<double, kMaxAxes>& q, int& tool) noexcept = 0;
 };
 
 // Factories. `speed` applies to replay (1 = real time, 0 = as fast as possible) and to the

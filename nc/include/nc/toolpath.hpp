@@ -2,7 +2,8 @@
 //
 // A tool path is a sequence of segments in the workpiece frame. Positions are the tool tip
 // (tool length already applied) in mm, rotary axes in degrees. Front ends: the move list
-// (nc/movelist.hpp) and the G-code interpreter.
+// (nc/movelist.hpp), the G-code interpreter (nc/gcode.hpp) and LinuxCNC's rs274 (nc/rs274.hpp);
+// frames in docs/nc-frontend.md#frames. The machine emulator (nc/emulator.hpp) consumes it.
 #pragma once
 
 #include <array>

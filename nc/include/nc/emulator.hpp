@@ -1,0 +1,96 @@
+// nc/emulator.hpp — machine emulator: a Toolpath as a controller would execute and report it.
+//
+// Motion model (docs/nc-frontend.md#emulator): every Rapid/Feed segment is a straight line in
+// X Y Z A B C run with a trapezoidal velocity profile that starts and ends at rest (exact stop
+// at every corner, no blending). The path speed is the programmed feed (rapid rate for
+// Rapid), lowered so that no axis exceeds its velocity limit; the path acceleration is the
+// largest at which no axis exceeds its acceleration limit. Dwell and ToolChange hold the
+// position for dwell_s / tool_change_s. The path parameter is the XYZ length [mm], or the
+// rotary length [deg] for rotary-only moves (their feed is then read as deg/min).
+//
+// Samples are taken every period at t = (seq + 1) * period, seq = 0, 1, ...; the last one is
+// the first at or after the end of the program, so count * period - total time is in
+// [0, period). Deterministic: the same path and limits give bit-identical samples.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "nc/toolpath.hpp"
+
+namespace lbr::nc {
+
+struct EmulatorLimits {
+  double rapid_mm_per_min = 15000.0;   // rapid rate along the path [mm/min]
+  double max_feed_mm_per_min = 0.0;    // cap on programmed feeds [mm/min]; 0: none
+  AxisVector max_velocity{15000, 15000, 15000, 3600, 3600, 3600};  // per axis [mm/min | deg/min]
+  AxisVector max_accel{1000, 1000, 1000, 720, 720, 720};           // per axis [mm/s² | deg/s²]
+  double sample_period_ms = 4.0;       // [ms]
+  double tool_change_s = 0.0;          // [s]
+};
+
+// Checks the limits; returns "" when usable, else what is wrong (e.g. "sample period must be > 0 ms").
+[[nodiscard]] std::string validate(const EmulatorLimits& limits);
+
+struct Sample {
+  std::uint64_t seq = 0;  // 0, 1, 2, ...
+  double t_s = 0.0;       // (seq + 1) * period [s]
+  int tool = 0;           // tool in the spindle
+  AxisVector axes{};      // tool tip in the Toolpath frame [mm, deg]
+};
+
+// Incremental sample generator. The constructor plans the whole path (allocates, may throw
+// std::invalid_argument for invalid limits or segments, naming the source line); next()
+// and the queries are real-time safe: no allocation, no exceptions, no locks.
+class Emulator {
+ public:
+  Emulator(const Toolpath& path, const EmulatorLimits& limits);
+
+  // Writes the next sample and returns true; false (and `out` untouched) after the last one.
+  bool next(Sample& out) noexcept;
+  // Back to the first sample.
+  void reset() noexcept { seq_ = 0, seg_ = 0; }
+
+  [[nodiscard]] double total_time_s() const noexcept { return total_s_; }
+  [[nodiscard]] std::uint64_t sample_count() const noexcept { return count_; }
+  [[nodiscard]] double period_s() const noexcept { return period_s_; }
+
+  // Position and tool at time t [s] (clamped to [0, total]). Real-time safe; O(log n).
+  void state_at(double t_s, AxisVector& axes, int& tool) const noexcept;
+
+  // Planned motion of one segment (exposed for tests and tools).
+  struct Plan {
+    AxisVector from{}, to{};
+    double t0_s = 0.0;        // start time [s]
+    double duration_s = 0.0;  // [s]
+    double length = 0.0;      // path parameter length [mm or deg]
+    double v = 0.0;           // cruise speed [unit/s]
+    double a = 0.0;           // acceleration [unit/s²]
+    double t_acc_s = 0.0;     // acceleration phase (= deceleration phase) [s]
+    int tool = 0;             // tool during the segment
+    int line = 0;
+  };
+  [[nodiscard]] const std::vector<Plan>& plans() const noexcept { return plans_; }
+
+ private:
+  void eval(std::size_t i, double t_s, AxisVector& axes) const noexcept;
+
+  std::vector<Plan> plans_;
+  AxisVector start_{};
+  int start_tool_ = 0;
+  double period_s_ = 0.004;
+  double total_s_ = 0.0;
+  std::uint64_t count_ = 0;
+  std::uint64_t seq_ = 0;
+  std::size_t seg_ = 0;
+};
+
+// Total time [s] the emulated machine needs for `path`.
+[[nodiscard]] double emulated_time_s(const Toolpath& path, const EmulatorLimits& limits);
+
+// The sampled stream as a tool path, as live mode sees it: one Feed segment from sample to
+// sample (has_tool_axis false; feed = distance / period), a ToolChange where the tool changes.
+[[nodiscard]] Toolpath sampled_toolpath(const Toolpath& path, const EmulatorLimits& limits);
+
+}  // namespace lbr::nc

@@ -1,0 +1,59 @@
+// nc/gcode.hpp — G-code (RS274/ISO, the dialect CAM post-processors write) to a Toolpath.
+//
+// Two front ends produce the same Toolpath from a part program:
+//  - interpret_gcode(): the built-in interpreter (coverage in docs/nc-frontend.md);
+//  - the LinuxCNC `rs274` canonical-command stream (nc/rs274.hpp), for programs that use
+//    subroutines, parameters, loops or cutter compensation.
+//
+// Frames (docs/nc-frontend.md#frames): the Toolpath is in the G54 frame as it stands at
+// program start (GcodeOptions::work_offsets[0]); the profile's stock is given in that frame.
+// Machine coordinates (G53, G28/G30 home, work offsets) refer to the spindle gauge line;
+// tool tip = gauge line - loaded tool length along Z. Programmed coordinates are those of the
+// controlled point as in LinuxCNC: with G43 H<loaded tool> active the programmed Z is the tip.
+//
+// Not real-time code: the interpreter allocates and throws ParseError.
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+
+#include "nc/toolpath.hpp"
+
+namespace lbr::nc {
+
+// Which axis words a program may use.
+enum class MachineKind : unsigned char {
+  Mill3,       // X Y Z
+  MillRotary,  // X Y Z A B C (rotary axes [deg] carried into Segment::end[A..C])
+  Lathe,       // X Z; G7 diameter mode / G8 radius mode apply to X words
+};
+
+struct GcodeOptions {
+  MachineKind machine = MachineKind::Mill3;
+  std::map<int, double> tool_lengths;    // tool number -> gauge line to tip [mm]; missing = 0
+  std::map<int, double> tool_diameters;  // tool number -> diameter [mm]; used by rs274's cutter
+                                         // compensation (the built-in interpreter rejects G41/G42)
+  double chord_tol_mm = 0.001;         // max distance of an arc chord from the arc [mm]
+  // Machine coordinates of the G54, G55, ... G59, G59.1, G59.2, G59.3 origins [mm, deg]
+  // at program start (G10 L2 changes them while the program runs). work_offsets[0] defines
+  // the Toolpath frame.
+  std::array<AxisVector, 9> work_offsets{};
+  AxisVector g28_home{};       // machine coordinates of the G28 position [mm, deg]
+  AxisVector g30_home{};       // machine coordinates of the G30 position [mm, deg]
+  AxisVector start_machine{};  // gauge line at program start, machine coordinates (homed: 0)
+  int start_tool = 0;          // tool in the spindle at program start (0 = none)
+};
+
+// Interprets G-code text. `name` is used in messages and as Toolpath::source. Arcs become
+// Feed segments whose chords deviate at most chord_tol_mm from the arc. Every segment
+// carries its 1-based source line. Throws ParseError ("NAME:LINE: message naming the word")
+// for malformed or unsupported input; never skips a word silently.
+[[nodiscard]] Toolpath interpret_gcode(const std::string& text, const std::string& name, const GcodeOptions& options);
+// Reads and interprets a file. Throws ParseError (line 0 when the file cannot be read).
+[[nodiscard]] Toolpath load_gcode(const std::string& path, const GcodeOptions& options);
+
+// Reads a whole file into a string. Throws ParseError(path, 0, "cannot open file").
+[[nodiscard]] std::string read_text_file(const std::string& path);
+
+}  // namespace lbr::nc

@@ -1,0 +1,676 @@
+// The built-in G-code interpreter. Coverage, frames and error messages: docs/nc-frontend.md.
+//
+// Each line is parsed into a block of words, then executed in the RS274/NGC order of
+// execution (feed mode, F, S, T, M6, spindle, dwell, planes, units, tool length, work
+// offsets, distance modes, G10/G28/G30/G53, motion, stops). Motion goes through the shared
+// PathBuilder, which also serves the rs274 canonical stream, so both front ends convert
+// coordinates identically.
+#include "nc/gcode.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "path_builder.hpp"
+
+namespace lbr::nc {
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw ParseError(path, 0, "cannot open file");
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+namespace {
+
+using detail::PathBuilder;
+using detail::Plane;
+
+constexpr double kInch = 25.4;
+constexpr double kMaxAbsValue = 1e9;  // larger numbers are rejected (keeps arithmetic finite)
+constexpr long kMaxPecks = 100000;
+constexpr long kMaxRepeats = 10000;
+// LinuxCNC's peck clearances (interp_cycles.cc): 0.010 inch, in mm.
+constexpr double kG83RapidDelta = 0.010 * kInch;
+constexpr double kG73Retract = 0.010 * kInch;
+
+constexpr const char* kUseRs274 = "; use --interpreter rs274";
+
+std::string fmt(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+struct Word {
+  char letter = 0;
+  double value = 0.0;
+  std::string text;  // as written, e.g. "G1", "X-2.5"
+};
+
+struct Block {
+  std::vector<Word> g, m;
+  std::array<bool, 26> has{};
+  std::array<double, 26> val{};
+  std::array<std::string, 26> text;
+  std::array<bool, 26> used{};
+  bool empty() const {
+    if (!g.empty() || !m.empty()) return false;
+    for (bool h : has)
+      if (h) return false;
+    return true;
+  }
+};
+
+int idx(char c) { return c - 'A'; }
+
+class Interpreter {
+ public:
+  Interpreter(const std::string& name, const GcodeOptions& o)
+      : name_(name), opt_(o), b_(name, o), offsets_(o.work_offsets), g28_(o.g28_home), g30_(o.g30_home) {
+    selected_tool_ = o.start_tool;
+  }
+
+  Toolpath run(const std::string& text) {
+    std::istringstream in(text);
+    std::string raw;
+    int percent = 0;
+    while (std::getline(in, raw)) {
+      ++line_;
+      if (!raw.empty() && raw.back() == '\r') raw.pop_back();
+      const auto first = raw.find_first_not_of(" \t");
+      if (first != std::string::npos && raw[first] == '%') {
+        if (++percent == 2) break;  // closing delimiter: the program ends here
+        continue;
+      }
+      Block blk = parse(raw);
+      if (blk.empty()) continue;
+      execute(blk);
+      if (ended_) break;
+    }
+    return b_.take();
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& msg) const { throw ParseError(name_, line_, msg); }
+
+  // ---- parsing -------------------------------------------------------------------------
+  Block parse(const std::string& s) {
+    Block blk;
+    std::size_t i = 0;
+    const std::size_t n = s.size();
+    auto skip_ws = [&] {
+      while (i < n && (s[i] == ' ' || s[i] == '\t')) ++i;
+    };
+    skip_ws();
+    if (i < n && s[i] == '/') ++i;  // block delete switch is off: the block runs
+    while (true) {
+      skip_ws();
+      if (i >= n) break;
+      const char c = s[i];
+      if (c == ';') break;
+      if (c == '(') {
+        const auto close = s.find(')', i);
+        if (close == std::string::npos) fail("unclosed comment '('");
+        i = close + 1;
+        continue;
+      }
+      if (c == '#') {
+        std::size_t e = i + 1;
+        while (e < n && s[e] != ' ' && s[e] != '\t' && s[e] != '=') ++e;
+        fail("unsupported word '" + s.substr(i, e - i) + "' (parameters" + kUseRs274 + ")");
+      }
+      if (c == '[') fail(std::string("unsupported word '[' (expressions") + kUseRs274 + ")");
+      if (!std::isalpha(static_cast<unsigned char>(c))) {
+        fail(std::string("unexpected character '") + c + "'");
+      }
+      const char L = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      ++i;
+      skip_ws();
+      if (L == 'O') {
+        std::size_t e = i;
+        while (e < n && std::isalnum(static_cast<unsigned char>(s[e]))) ++e;
+        fail("unsupported word 'O" + s.substr(i, e - i) + "' (O-word subroutines and control flow" + kUseRs274 + ")");
+      }
+      if (i < n && (s[i] == '[' || s[i] == '#')) {
+        std::size_t e = i;
+        while (e < n && s[e] != ' ' && s[e] != '\t') ++e;
+        fail(std::string("unsupported word '") + L + s.substr(i, e - i) + "' (" +
+             (s[i] == '[' ? "expressions" : "parameters") + kUseRs274 + ")");
+      }
+      const std::size_t num_start = i;
+      if (i < n && (s[i] == '+' || s[i] == '-')) ++i;
+      std::size_t digits = 0;
+      while (i < n && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++digits;
+      if (i < n && s[i] == '.') {
+        ++i;
+        while (i < n && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++digits;
+      }
+      if (digits == 0) fail(std::string("word '") + L + "' has no number");
+      const std::string num = s.substr(num_start, i - num_start);
+      const double v = std::strtod(num.c_str(), nullptr);
+      Word w{L, v, std::string(1, L) + num};
+      if (!std::isfinite(v) || std::abs(v) > kMaxAbsValue) fail("number out of range in '" + w.text + "'");
+      switch (L) {
+        case 'G': blk.g.push_back(w); break;
+        case 'M': blk.m.push_back(w); break;
+        case 'N': break;  // line number: no meaning to the motion
+        case 'X': case 'Y': case 'Z': case 'A': case 'B': case 'C': case 'I': case 'J': case 'K':
+        case 'R': case 'P': case 'Q': case 'L': case 'H': case 'F': case 'S': case 'T': case 'D': {
+          const int k = idx(L);
+          if (blk.has[k]) fail("word '" + std::string(1, L) + "' given twice ('" + blk.text[k] + "', '" + w.text + "')");
+          blk.has[k] = true;
+          blk.val[k] = v;
+          blk.text[k] = w.text;
+          break;
+        }
+        case 'U': case 'V': case 'W': fail("unsupported word '" + w.text + "' (axes U, V, W are not supported)");
+        default: fail("unsupported word '" + w.text + "'");
+      }
+    }
+    return blk;
+  }
+
+  // ---- word access -----------------------------------------------------------------------
+  bool has(const Block& b, char L) const { return b.has[idx(L)]; }
+  double raw(Block& b, char L) {
+    b.used[idx(L)] = true;
+    return b.val[idx(L)];
+  }
+  double len(Block& b, char L) { return raw(b, L) * scale_; }
+  const std::string& text(const Block& b, char L) const { return b.text[idx(L)]; }
+  int integer(Block& b, char L, int lo, int hi) {
+    const double v = raw(b, L);
+    if (v != std::floor(v) || v < lo || v > hi)
+      fail("'" + text(b, L) + "': expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return static_cast<int>(v);
+  }
+
+  static constexpr char kAxisLetters[kAxes] = {'X', 'Y', 'Z', 'A', 'B', 'C'};
+  bool axis_allowed(int a) const {
+    switch (opt_.machine) {
+      case MachineKind::Mill3: return a <= Z;
+      case MachineKind::MillRotary: return true;
+      case MachineKind::Lathe: return a == X || a == Z;
+    }
+    return false;
+  }
+  const char* machine_name() const {
+    switch (opt_.machine) {
+      case MachineKind::Mill3: return "mill3 has X Y Z";
+      case MachineKind::MillRotary: return "mill-rotary has X Y Z A B C";
+      case MachineKind::Lathe: return "lathe has X Z";
+    }
+    return "?";
+  }
+  bool any_axis(const Block& b) const {
+    for (char L : kAxisLetters)
+      if (has(b, L)) return true;
+    return false;
+  }
+  // An axis word in the block's units (and lathe diameter mode for X) [mm, deg].
+  double axis_value(Block& b, int a) {
+    const char L = kAxisLetters[a];
+    if (a >= A) return raw(b, L);
+    double v = len(b, L);
+    if (a == X && diameter_mode_) v *= 0.5;
+    return v;
+  }
+  // End point of a move: program coordinates.
+  AxisVector target(Block& b, bool machine_coords) {
+    if (machine_coords) {
+      AxisVector m = b_.to_machine(b_.position());
+      for (int a = 0; a < kAxes; ++a)
+        if (has(b, kAxisLetters[a])) m[a] = axis_value(b, a);
+      return b_.from_machine(m);
+    }
+    AxisVector t = b_.position();
+    for (int a = 0; a < kAxes; ++a) {
+      if (!has(b, kAxisLetters[a])) continue;
+      const double v = axis_value(b, a);
+      t[a] = absolute_ ? v : t[a] + v;
+    }
+    return t;
+  }
+
+  // ---- execution -------------------------------------------------------------------------
+  static int code10(const Word& w) { return static_cast<int>(std::lround(w.value * 10.0)); }
+
+  enum Group { kMotion, kPlane, kDistance, kArcDistance, kFeedMode, kUnits, kCutter, kLength, kRetract, kCoord,
+               kPath, kLathe, kNonModal, kGroups };
+  int group_of(const Word& w) const {
+    const int c = code10(w);
+    if (std::abs(w.value * 10.0 - c) > 1e-6) return -1;
+    switch (c) {
+      case 0: case 10: case 20: case 30: case 800: case 810: case 820: case 830: case 730: return kMotion;
+      case 170: case 180: case 190: return kPlane;
+      case 900: case 910: return kDistance;
+      case 901: case 911: return kArcDistance;
+      case 930: case 940: return kFeedMode;
+      case 200: case 210: return kUnits;
+      case 400: return kCutter;
+      case 430: case 490: return kLength;
+      case 980: case 990: return kRetract;
+      case 540: case 550: case 560: case 570: case 580: case 590: case 591: case 592: case 593: return kCoord;
+      case 610: case 611: case 640: return kPath;
+      case 70: case 80: return kLathe;
+      case 40: case 100: case 280: case 281: case 300: case 301: case 530: return kNonModal;
+      default: return -1;
+    }
+  }
+  std::string unsupported_g(const Word& w) const {
+    const int c = code10(w);
+    const char* why = "not supported by the built-in interpreter";
+    if (c == 410 || c == 420 || c == 411 || c == 421) why = "cutter radius compensation";
+    else if (c == 920 || c == 921 || c == 922 || c == 923) why = "G92 offsets";
+    else if (c == 381 || c == 382 || c == 383 || c == 384) why = "probing";
+    else if (c == 431) why = "dynamic tool length offset";
+    else if (c == 330 || c == 331 || c == 760 || c == 840 || c == 850 || c == 860 || c == 870 || c == 880 ||
+             c == 890)
+      why = "this cycle";
+    return "unsupported word '" + w.text + "' (" + why + kUseRs274 + ")";
+  }
+
+  void execute(Block& b) {
+    // Modal groups: one G-code per group and block.
+    std::array<const Word*, kGroups> gw{};
+    std::vector<const Word*> nonmodal;
+    for (const Word& w : b.g) {
+      const int gr = group_of(w);
+      if (gr < 0) fail(unsupported_g(w));
+      if (gr == kNonModal) {
+        nonmodal.push_back(&w);
+        continue;
+      }
+      if (gw[gr] != nullptr) fail("'" + gw[gr]->text + "' and '" + w.text + "' are in the same modal group");
+      gw[gr] = &w;
+    }
+    int dwell = 0, g10 = 0, home = 0, g53 = 0;  // home: 280, 281, 300, 301
+    for (const Word* w : nonmodal) {
+      const int c = code10(*w);
+      int* slot = c == 40 ? &dwell : c == 100 ? &g10 : c == 530 ? &g53 : &home;
+      if (*slot != 0 || (slot == &g10 && home != 0) || (slot == &home && g10 != 0))
+        fail("'" + w->text + "' cannot be combined with another non-modal G-code in the block");
+      *slot = c;
+    }
+    const Word* mstop = nullptr;
+    const Word* mspindle = nullptr;
+    const Word* m6 = nullptr;
+    const Word* mcool = nullptr;
+    for (const Word& w : b.m) {
+      const int c = static_cast<int>(std::lround(w.value));
+      if (w.value != std::floor(w.value)) fail("unsupported word '" + w.text + "'");
+      const Word** slot = nullptr;
+      switch (c) {
+        case 0: case 1: case 2: case 30: slot = &mstop; break;
+        case 3: case 4: case 5: slot = &mspindle; break;
+        case 6: slot = &m6; break;
+        case 7: case 8: case 9: slot = &mcool; break;
+        default: fail("unsupported word '" + w.text + "' (not supported by the built-in interpreter" +
+                      std::string(kUseRs274) + ")");
+      }
+      if (*slot != nullptr && !(c == 7 || c == 8))
+        fail("'" + (*slot)->text + "' and '" + w.text + "' are in the same modal group");
+      *slot = &w;
+    }
+
+    // 1. feed mode, F
+    if (gw[kFeedMode]) inverse_time_ = code10(*gw[kFeedMode]) == 930;
+    bool f_in_block = false;
+    if (has(b, 'F')) {
+      feed_ = raw(b, 'F');
+      if (feed_ < 0) fail("'" + text(b, 'F') + "': feed rate must be >= 0");
+      f_in_block = true;
+    }
+    // 2. S
+    if (has(b, 'S')) {
+      spindle_rpm_ = raw(b, 'S');
+      if (spindle_rpm_ < 0) fail("'" + text(b, 'S') + "': spindle speed must be >= 0");
+    }
+    // 3. T (select), 4. M6 (change)
+    if (has(b, 'T')) selected_tool_ = integer(b, 'T', 0, 99999);
+    if (m6 != nullptr) b_.tool_change(line_, selected_tool_);
+    // 5. spindle, coolant
+    if (mspindle != nullptr) spindle_ = static_cast<int>(mspindle->value);
+    if (mcool != nullptr) coolant_ = static_cast<int>(mcool->value);
+    // 6. dwell
+    if (dwell != 0) {
+      if (!has(b, 'P')) fail("'G4' needs P (dwell time [s])");
+      const double p = raw(b, 'P');
+      if (p < 0) fail("'" + text(b, 'P') + "': dwell time must be >= 0");
+      b_.dwell(line_, p);
+    }
+    // 7. modal settings
+    if (gw[kPlane]) {
+      const int c = code10(*gw[kPlane]);
+      plane_ = c == 170 ? Plane::XY : c == 180 ? Plane::ZX : Plane::YZ;
+    }
+    if (gw[kUnits]) scale_ = code10(*gw[kUnits]) == 200 ? kInch : 1.0;
+    // kCutter: G40 (compensation off) is the only state the interpreter has.
+    if (gw[kLathe]) {
+      if (opt_.machine != MachineKind::Lathe)
+        fail("'" + gw[kLathe]->text + "' (lathe " + (code10(*gw[kLathe]) == 70 ? "diameter" : "radius") +
+             " mode) needs machine kind lathe");
+      diameter_mode_ = code10(*gw[kLathe]) == 70;
+    }
+    if (gw[kLength]) {
+      const AxisVector m = b_.to_machine(b_.position());
+      if (code10(*gw[kLength]) == 430) {
+        const int h = has(b, 'H') ? integer(b, 'H', 0, 99999) : b_.tool();
+        b_.set_tool_length_offset(b_.tool_length(h));
+      } else {
+        b_.set_tool_length_offset(0.0);
+      }
+      b_.set_position(b_.from_machine(m));
+    }
+    if (gw[kCoord]) {
+      const int c = code10(*gw[kCoord]);
+      int k = 0;
+      if (c <= 590) k = (c - 540) / 10;
+      else k = 6 + (c - 591);
+      select_wcs(k);
+    }
+    // kPath: G61/G61.1/G64 are accepted; the emulator always stops exactly at corners.
+    if (gw[kDistance]) absolute_ = code10(*gw[kDistance]) == 900;
+    if (gw[kArcDistance]) arc_absolute_ = code10(*gw[kArcDistance]) == 901;
+    if (gw[kRetract]) retract_to_initial_ = code10(*gw[kRetract]) == 980;
+
+    // Axis words must exist on the machine.
+    for (int a = 0; a < kAxes; ++a)
+      if (has(b, kAxisLetters[a]) && !axis_allowed(a))
+        fail("word '" + text(b, kAxisLetters[a]) + "' needs an axis the machine lacks (machine kind " + machine_name() + ")");
+
+    // 8. G10, G28/G30, G53; 9. motion
+    if (gw[kMotion]) {
+      const int c = code10(*gw[kMotion]);
+      if (c != motion_ && is_cycle(c)) cycle_sticky_ = {};
+      if (!is_cycle(c)) cycle_series_ = false;
+      motion_ = c;
+      if (c == 800) motion_ = -1;
+    }
+    if (g10 != 0) {
+      do_g10(b);
+    } else if (home != 0) {
+      if (gw[kMotion] != nullptr && any_axis(b))
+        fail("'" + gw[kMotion]->text + "' and 'G" + (home < 300 ? std::string("28") : std::string("30")) +
+             (home % 10 ? ".1" : "") + "' both use the axis words");
+      do_home(b, home);
+    } else if (g53 != 0) {
+      const int c = gw[kMotion] ? code10(*gw[kMotion]) : motion_;
+      if (c != 0 && c != 10) fail("'G53' needs G0 or G1 in the block or in effect");
+      if (!absolute_) fail("'G53' needs absolute distance mode (G90)");
+      const AxisVector t = target(b, true);
+      move_line(c, t, f_in_block);
+    } else if (any_axis(b) || (gw[kMotion] != nullptr && (is_cycle(motion_) || motion_ == 20 || motion_ == 30))) {
+      if (motion_ < 0) {
+        for (char L : kAxisLetters)
+          if (has(b, L)) fail("axis word '" + text(b, L) + "' given but no motion mode is in effect");
+      }
+      if (motion_ == 0 || motion_ == 10) move_line(motion_, target(b, false), f_in_block);
+      else if (motion_ == 20 || motion_ == 30) move_arc(b, f_in_block);
+      else if (motion_ >= 0) canned_cycle(b);
+    }
+
+    // Every word must have been used by something in the block.
+    for (char L : {'X', 'Y', 'Z', 'A', 'B', 'C', 'F', 'S', 'T'}) b.used[idx(L)] = b.used[idx(L)] || has(b, L);
+    if (has(b, 'D')) fail("unsupported word '" + text(b, 'D') + "' (cutter radius compensation" + kUseRs274 + ")");
+    for (int k = 0; k < 26; ++k)
+      if (b.has[k] && !b.used[k]) fail("unused word '" + b.text[k] + "' (no G-code in the block uses it)");
+
+    // 10. stops
+    if (mstop != nullptr) {
+      const int c = static_cast<int>(mstop->value);
+      if (c == 2 || c == 30) ended_ = true;
+      else ++pauses_;  // M0/M1: program pause; no motion
+    }
+  }
+
+  static bool is_cycle(int c) { return c == 810 || c == 820 || c == 830 || c == 730; }
+
+  void select_wcs(int k) {
+    const AxisVector m = b_.to_machine(b_.position());
+    wcs_ = k;
+    b_.set_origin(offsets_[static_cast<std::size_t>(k)]);
+    b_.set_position(b_.from_machine(m));
+  }
+
+  void do_g10(Block& b) {
+    if (!has(b, 'L') || raw(b, 'L') != 2.0)
+      fail("'G10' needs L2 (work offsets); " + (has(b, 'L') ? "'" + text(b, 'L') + "'" : std::string("no L word")) +
+           " is not supported");
+    if (has(b, 'R')) fail("unsupported word '" + text(b, 'R') + "' (G10 L2 rotation)");
+    if (!has(b, 'P')) fail("'G10 L2' needs P0..P9 (coordinate system)");
+    int p = integer(b, 'P', 0, 9);
+    const int k = p == 0 ? wcs_ : p - 1;
+    AxisVector& o = offsets_[static_cast<std::size_t>(k)];
+    for (int a = 0; a < kAxes; ++a)
+      if (has(b, kAxisLetters[a])) o[a] = axis_value(b, a);
+    if (k == wcs_) select_wcs(k);
+  }
+
+  void do_home(Block& b, int code) {
+    AxisVector& stored = code < 300 ? g28_ : g30_;
+    if (code % 10 == 1) {  // G28.1 / G30.1: store the current machine position
+      stored = b_.to_machine(b_.position());
+      return;
+    }
+    const bool axes = any_axis(b);
+    if (axes) b_.rapid(line_, target(b, false));
+    AxisVector m = b_.to_machine(b_.position());
+    for (int a = 0; a < kAxes; ++a)
+      if (!axes || has(b, kAxisLetters[a])) m[a] = stored[a];
+    b_.rapid(line_, b_.from_machine(m));
+  }
+
+  double feed_for_move(const std::string& g, bool f_in_block) const {
+    if (inverse_time_) {
+      if (!f_in_block) fail("'" + g + "' in inverse time mode (G93) needs an F word in the block");
+      if (feed_ <= 0.0) fail("'" + g + "' in inverse time mode (G93) needs F > 0");
+      return feed_;
+    }
+    if (feed_ <= 0.0) fail("'" + g + "' needs a feed rate: no F word > 0 given yet");
+    return feed_ * scale_;
+  }
+
+  void move_line(int c, const AxisVector& t, bool f_in_block) {
+    if (c == 0) {
+      b_.rapid(line_, t);
+    } else {
+      const double f = feed_for_move("G1", f_in_block);
+      b_.feed(line_, t, f, inverse_time_);
+    }
+  }
+
+  void move_arc(Block& b, bool f_in_block) {
+    const std::string g = motion_ == 20 ? "G2" : "G3";
+    const detail::PlaneAxes ax = detail::plane_axes(plane_);
+    static constexpr char kCentre[3] = {'I', 'J', 'K'};  // centre word of X, Y, Z
+    const char cu_l = kCentre[ax.u], cv_l = kCentre[ax.v];
+    const char* plane_name = plane_ == Plane::XY ? "XY" : plane_ == Plane::ZX ? "XZ" : "YZ";
+    const bool ijk = has(b, cu_l) || has(b, cv_l);
+    const bool r_form = has(b, 'R');
+    if (ijk && r_form) fail("'" + g + "' with both R and a centre word (" + cu_l + "/" + cv_l + ")");
+    if (!ijk && !r_form) fail("'" + g + "' needs R or a centre word " + cu_l + "/" + cv_l + " (plane " + plane_name + ")");
+    int turns = 1;
+    if (has(b, 'P')) turns = integer(b, 'P', 1, 1000);
+    const double f = feed_for_move(g, f_in_block);
+    const AxisVector start = b_.position();
+    const AxisVector end = target(b, false);
+    const double du = end[ax.u] - start[ax.u], dv = end[ax.v] - start[ax.v];
+    double cu = 0.0, cv = 0.0;
+    if (r_form) {
+      const double r = len(b, 'R');
+      const double d = std::hypot(du, dv);
+      if (d < 1e-9) fail("'" + g + "' in R form cannot make a full circle (end point = start point)");
+      double h2 = r * r - 0.25 * d * d;
+      if (h2 < 0.0) {
+        if (std::abs(r) < 0.5 * d - 0.001)
+          fail("'" + g + "' radius '" + text(b, 'R') + "' is too small for an end point " + fmt(d) + " mm away");
+        h2 = 0.0;
+      }
+      const double h = std::sqrt(h2);
+      // Centre left of the chord for counter-clockwise short arcs; R < 0 asks for the long arc.
+      double side = motion_ == 30 ? 1.0 : -1.0;
+      if (r < 0) side = -side;
+      cu = start[ax.u] + 0.5 * du - side * h * dv / d;
+      cv = start[ax.v] + 0.5 * dv + side * h * du / d;
+    } else {
+      if (arc_absolute_) {
+        if (!has(b, cu_l) || !has(b, cv_l))
+          fail("'" + g + "' with absolute arc centres (G90.1) needs both " + cu_l + " and " + cv_l);
+        cu = len(b, cu_l);
+        cv = len(b, cv_l);
+      } else {
+        cu = start[ax.u] + (has(b, cu_l) ? len(b, cu_l) : 0.0);
+        cv = start[ax.v] + (has(b, cv_l) ? len(b, cv_l) : 0.0);
+      }
+      const double r0 = std::hypot(start[ax.u] - cu, start[ax.v] - cv);
+      const double r1 = std::hypot(end[ax.u] - cu, end[ax.v] - cv);
+      if (r0 < 1e-9) fail("'" + g + "' has zero radius (centre = start point)");
+      const double err = std::abs(r1 - r0);
+      if (err > 0.002 && err > 0.001 * r0)
+        fail("'" + g + "' end point is off the circle: start radius " + fmt(r0) + " mm, end radius " + fmt(r1) + " mm");
+    }
+    b_.arc(line_, plane_, end, cu, cv, motion_ == 30 ? turns : -turns, f, inverse_time_);
+  }
+
+  void canned_cycle(Block& b) {
+    const std::string g = motion_ == 810 ? "G81" : motion_ == 820 ? "G82" : motion_ == 830 ? "G83" : "G73";
+    if (plane_ != Plane::XY) fail("canned cycle '" + g + "' needs plane G17 (XY)");
+    for (char L : {'A', 'B', 'C'})
+      if (has(b, L)) fail("canned cycle '" + g + "' with rotary axis word '" + text(b, L) + "'");
+    CycleSticky& cs = cycle_sticky_;
+    if (has(b, 'R')) cs.r = len(b, 'R'), cs.has_r = true;
+    if (has(b, 'Z')) cs.z = len(b, 'Z'), cs.has_z = true;
+    b.used[idx('Z')] = true;
+    if (has(b, 'Q')) {
+      cs.q = len(b, 'Q');
+      cs.has_q = true;
+      if (motion_ != 830 && motion_ != 730) fail("unused word '" + text(b, 'Q') + "' (" + g + " takes no Q)");
+    }
+    if (has(b, 'P')) {
+      cs.p = raw(b, 'P');
+      cs.has_p = true;
+      if (motion_ != 820) fail("unused word '" + text(b, 'P') + "' (" + g + " takes no P)");
+    }
+    if (!cs.has_r || !cs.has_z) fail("canned cycle '" + g + "' needs R and Z");
+    if ((motion_ == 830 || motion_ == 730) && (!cs.has_q || cs.q <= 0.0)) fail("'" + g + "' needs Q > 0 (peck depth)");
+    if (motion_ == 820 && (!cs.has_p || cs.p < 0.0)) fail("'G82' needs P >= 0 (dwell time [s])");
+    const double f = feed_for_move(g, has(b, 'F'));
+    int repeats = 1;
+    if (has(b, 'L')) repeats = integer(b, 'L', 0, static_cast<int>(kMaxRepeats));
+
+    AxisVector p = b_.position();
+    const double r = absolute_ ? cs.r : p[Z] + cs.r;
+    const double bottom = absolute_ ? cs.z : r + cs.z;
+    if (bottom > r) fail("canned cycle '" + g + "': R (" + fmt(r) + ") is below Z (" + fmt(bottom) + ")");
+    const double q = cs.q;
+    if ((motion_ == 830 || motion_ == 730) && (r - bottom) / q > static_cast<double>(kMaxPecks))
+      fail("'" + g + "': more than " + std::to_string(kMaxPecks) + " pecks");
+
+    // G98 retracts to the initial level: Z before this series of contiguous canned cycle
+    // blocks began (raised to R when it started below R), as LinuxCNC does.
+    if (!cycle_series_) {
+      cycle_series_ = true;
+      cycle_initial_z_ = p[Z];
+      if (p[Z] < r) {
+        p[Z] = r;
+        b_.rapid(line_, p);
+        cycle_initial_z_ = r;
+      }
+    }
+    double old_z = retract_to_initial_ ? std::max(cycle_initial_z_, r) : p[Z];
+    const double clear = retract_to_initial_ ? std::max(cycle_initial_z_, r) : r;
+    double x = p[X], y = p[Y];
+    const double dx = has(b, 'X') ? axis_value(b, X) : 0.0;
+    const double dy = has(b, 'Y') ? axis_value(b, Y) : 0.0;
+    auto at = [&](double z) {
+      AxisVector v = b_.position();
+      v[X] = x, v[Y] = y, v[Z] = z;
+      return v;
+    };
+    for (int rep = 0; rep < repeats; ++rep) {
+      if (absolute_) {
+        if (has(b, 'X')) x = dx;
+        if (has(b, 'Y')) y = dy;
+      } else {
+        x += dx, y += dy;
+      }
+      b_.rapid(line_, at(old_z));
+      if (old_z != r) b_.rapid(line_, at(r));
+      switch (motion_) {
+        case 810: b_.feed(line_, at(bottom), f, inverse_time_); break;
+        case 820:
+          b_.feed(line_, at(bottom), f, inverse_time_);
+          b_.dwell(line_, cs.p);
+          break;
+        case 830:
+          for (double d = r - q; d > bottom; d -= q) {
+            b_.feed(line_, at(d), f, inverse_time_);
+            b_.rapid(line_, at(r));
+            b_.rapid(line_, at(d + kG83RapidDelta));
+          }
+          b_.feed(line_, at(bottom), f, inverse_time_);
+          break;
+        case 730:
+          for (double d = r - q; d > bottom; d -= q) {
+            b_.feed(line_, at(d), f, inverse_time_);
+            b_.rapid(line_, at(d + kG73Retract));
+          }
+          b_.feed(line_, at(bottom), f, inverse_time_);
+          break;
+        default: break;
+      }
+      b_.rapid(line_, at(clear));
+      old_z = clear;
+    }
+  }
+
+  struct CycleSticky {
+    double r = 0, z = 0, q = 0, p = 0;
+    bool has_r = false, has_z = false, has_q = false, has_p = false;
+  };
+
+  std::string name_;
+  const GcodeOptions& opt_;
+  PathBuilder b_;
+  std::array<AxisVector, 9> offsets_;
+  AxisVector g28_, g30_;
+  int line_ = 0;
+  bool ended_ = false;
+  int wcs_ = 0;
+  double scale_ = 1.0;  // mm per program length unit
+  bool absolute_ = true, arc_absolute_ = false, inverse_time_ = false, retract_to_initial_ = true;
+  bool diameter_mode_ = false;
+  Plane plane_ = Plane::XY;
+  int motion_ = -1;  // code x 10; -1: none (G80 or program start)
+  double feed_ = 0.0;
+  double spindle_rpm_ = 0.0;
+  int spindle_ = 5;  // M3, M4 or M5 (recorded, not in the Toolpath)
+  int coolant_ = 9;  // M7, M8 or M9 (recorded, not in the Toolpath)
+  int selected_tool_ = 0;
+  int pauses_ = 0;
+  CycleSticky cycle_sticky_;
+  bool cycle_series_ = false;     // inside a series of contiguous canned cycle blocks
+  double cycle_initial_z_ = 0.0;  // program Z when the series began
+};
+
+}  // namespace
+
+Toolpath interpret_gcode(const std::string& text, const std::string& name, const GcodeOptions& options) {
+  if (!(options.chord_tol_mm > 0.0)) throw ParseError(name, 0, "chord tolerance must be > 0 mm");
+  Interpreter in(name, options);
+  return in.run(text);
+}
+
+Toolpath load_gcode(const std::string& path, const GcodeOptions& options) {
+  return interpret_gcode(read_text_file(path), path, options);
+}
+
+}  // namespace lbr::nc
