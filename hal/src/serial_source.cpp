@@ -48,6 +48,8 @@ class SerialSource final : public Source {
   ~SerialSource() override { close(); }
 
   void open() override {
+    // LibSerial reports a missing device as "Bad file descriptor": say what is wrong first.
+    if (::access(dev_.c_str(), R_OK | W_OK) != 0) throw std::runtime_error("serial:" + dev_ + ": " + std::strerror(errno));
     termios settings{};
     int fd = -1;
     try {
