@@ -1,5 +1,7 @@
 #include "app/batch.hpp"
 
+#include "app/level_pool.hpp"
+
 #include <sys/resource.h>
 
 #include <chrono>
@@ -55,10 +57,12 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
     for (const auto& [n, sh] : shapes) dmax = std::max(dmax, sh.tool.diameter_mm);
     std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, dmax);
   }
-  BatchResult r{geom::LbrSolid(spec), 0, 0, 0, 0, 0, {}};
+  BatchResult r{geom::LbrSolid(spec), 0, 0, 0, 0, 0, {}, 1};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
   r.machining_time_s = machining_time_s(profile, path);
 
+  LevelPool pool(profile.threads);
+  r.threads = pool.threads();
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<geom::SweepRef> batch;
   batch.reserve(profile.batch_moves);
@@ -78,7 +82,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
     pose = next;
     ++r.moves;
     if (static_cast<int>(batch.size()) >= profile.batch_moves) {
-      r.stats += r.solid.subtract(batch);
+      r.stats += pool.subtract(r.solid, batch);
       batch.clear();
       if (progress) {
         const auto now = std::chrono::steady_clock::now();
@@ -89,7 +93,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
       }
     }
   }
-  if (!batch.empty()) r.stats += r.solid.subtract(batch);
+  if (!batch.empty()) r.stats += pool.subtract(r.solid, batch);
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.removed_volume_mm3 = r.stock_volume_mm3 - r.solid.volume_mm3();
   if (progress) progress(1.0);

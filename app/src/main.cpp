@@ -29,6 +29,7 @@ struct BatchOptions {
   std::string stl, ply;  // mesh exports (empty: none)
   std::vector<std::string> tools;
   double level_spacing = 0.0;
+  int threads = -1;
   bool quiet = false;
   bool sampled = false;
 };
@@ -78,6 +79,7 @@ int run_batch_command(const BatchOptions& o) {
   for (const std::string& t : o.tools) app::apply_tool_override(profile, t);
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
+  if (o.threads >= 0) profile.threads = o.threads;
 
   nc::Toolpath path =
       o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
@@ -179,6 +181,8 @@ int main(int argc, char** argv) {
       ->take_all();
   batch->add_option("--level-spacing", b.level_spacing, "Level spacing Δ [mm]")->check(CLI::Range(0.001, 1000.0));
   batch->add_option("--regions", b.regions, "Region grid NXxNY (e.g. 4x4) or auto");
+  batch->add_option("--threads", b.threads, "Kernel worker threads (0 = one per hardware thread; default: profile)")
+      ->check(CLI::Range(0, 256));
   batch->add_option("--out", b.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
   batch->add_flag("--quiet", b.quiet, "No progress messages");
   batch->add_option("--stl", b.stl, "Also write the reconstructed part as binary STL to this file");

@@ -330,6 +330,7 @@ Profile parse_profile(const std::string& text, const std::string& name) {
     p.solid.level_spacing_mm = s.number("level_spacing_mm", 0.1, 0.001, 1000.0, "mm");
     p.solid.chord_tol_mm = s.number("chord_tolerance_mm", 0.001, 0.0001, 1.0, "mm");
     p.batch_moves = static_cast<int>(s.integer("batch_moves", 64, 1, 100000));
+    p.threads = static_cast<int>(s.integer("threads", 0, 0, 256));
     p.solid.strictly_simple = true;
     if (const toml::node* r = s.get("regions")) {
       const auto v = r->value_exact<std::string>();

@@ -34,6 +34,7 @@ struct Profile {
   geom::SolidSpec solid;    // stock, Δ, region grid, chord tolerance
   bool regions_auto = false;
   int batch_moves = 64;     // moves per subtract() call in batch mode
+  int threads = 0;          // batch-mode kernel threads (0 = one per hardware thread)
   std::map<int, geom::Tool> tools;
   hal::LiveConfig live;     // [live], [[live.axis]], [threads]: `lbrsim run` (docs/profiles.md)
 };

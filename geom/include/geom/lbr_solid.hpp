@@ -110,8 +110,10 @@ class LbrSolid {
   SubtractStats subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws);
   // Same, for the levels [level_begin, level_end) only. Levels are independent, so callers
   // may run disjoint level ranges on several threads, each with its own workspace.
+  // `stride` > 1 takes every stride-th level from level_begin (interleaving balances the
+  // load when threads share one batch).
   SubtractStats subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
-                                SubtractWorkspace& ws);
+                                SubtractWorkspace& ws, int stride = 1);
 
   // 3D boolean difference with another LBR solid (the paper's OpBool): every level of this
   // solid loses the polygons of the other solid's level that contains the same mid-plane
