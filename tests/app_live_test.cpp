@@ -121,6 +121,27 @@ TEST(LiveRun, EmulatorWithToolChangesMatchesBatch) {
   EXPECT_GT(b.removed_volume_mm3, 100.0);
 }
 
+TEST(LiveRun, StraightRunsMergeIntoOneSweepPerBatch) {
+  // One straight cut: every chunk of samples (lbr.batch_moves in a non-live run) is
+  // collinear, so each batch subtracts a single sweep, and the volume is the batch volume.
+  const app::Profile p = app::default_profile();
+  const std::string program = "lbr-moves 1\nstart 5 20 5\ntool 1\nfeed 3000\nrapid 5 20 -2\nline 95 20 -2\n";
+  const std::string dir = testing::TempDir() + "/lbr_live_line";
+  std::filesystem::create_directories(dir);
+  const std::string file = dir + "/line.moves";
+  std::ofstream(file) << program;
+  std::atomic<bool> stop{false};
+  app::LiveOptions o;
+  o.source = "emulator:" + file;
+  o.speed = 0.0;
+  const app::LiveResult r = app::run_live(p, o, stop);
+  EXPECT_GT(r.samples_applied, 1500u);  // 90 mm at 50 mm/s plus the plunge
+  EXPECT_LE(r.sweeps, r.batches + 2);    // + the corner at the plunge's end, within one batch
+  EXPECT_LT(r.sweeps * 20, r.samples_applied);
+  const app::BatchResult b = app::run_batch(p, nc::parse_movelist(program, "line"));
+  EXPECT_NEAR(r.removed_volume_mm3, b.removed_volume_mm3, 2e-4 * b.removed_volume_mm3);
+}
+
 TEST(LiveRun, CandumpReplayWithFaultsMatchesBatch) {
   const app::Profile p = app::default_profile();
   const nc::Toolpath path = nc::parse_movelist(kShortProgram, "short");
