@@ -29,9 +29,10 @@ if [ "${LBR_SKIP_SANITIZERS:-0}" != "1" ]; then
         -R '^(SpscRing|LatencyHistogram|RtThread|PeriodicThread|LiveRun|LiveProfile)\.|^sched_ring_test_tsan$'
   if command -v clang++ >/dev/null 2>&1; then
     echo "== fuzzers (libFuzzer, fixed runs) =="
-    CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLBR_FUZZERS=ON \
+    CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLBR_BUILD_FUZZ=ON \
+          -DLBR_SANITIZE=fuzzer-no-link,address,undefined \
           -DLBR_BUILD_BENCH=OFF -DLBR_BUILD_TESTS=ON
     cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_serial fuzz_candump
-    ctest --test-dir build-fuzz --output-on-failure -L fuzz -R '^fuzz_'
+    ctest --test-dir build-fuzz --output-on-failure -L fuzz -R '^fuzz_(serial|candump)$'
   fi
 fi
