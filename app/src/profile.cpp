@@ -331,7 +331,11 @@ Profile parse_profile(const std::string& text, const std::string& name) {
     p.solid.chord_tol_mm = s.number("chord_tolerance_mm", 0.001, 0.0001, 1.0, "mm");
     p.batch_moves = static_cast<int>(s.integer("batch_moves", 64, 1, 100000));
     p.threads = static_cast<int>(s.integer("threads", 0, 0, 256));
-    p.solid.strictly_simple = true;
+    if (const toml::node* ss = s.get("strictly_simple")) {
+      const auto v = ss->value_exact<bool>();
+      if (!v) s.fail(ss, "strictly_simple", "expected true or false");
+      p.solid.strictly_simple = *v;
+    }
     if (const toml::node* r = s.get("regions")) {
       const auto v = r->value_exact<std::string>();
       if (!v) s.fail(r, "regions", "expected a string \"NXxNY\" or \"auto\"");
