@@ -8,6 +8,7 @@
 
 #include "geom/lbr_solid.hpp"
 #include "geom/tool.hpp"
+#include "hal/config.hpp"
 #include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
 
@@ -35,6 +36,7 @@ struct Profile {
   int batch_moves = 64;     // moves per subtract() call in batch mode
   int threads = 0;          // batch-mode kernel threads (0 = one per hardware thread)
   std::map<int, geom::Tool> tools;
+  hal::LiveConfig live;     // [live], [[live.axis]], [threads]: `lbrsim run` (docs/profiles.md)
 };
 
 // Parses profile text; `name` is used in messages. Throws ProfileError("name:line: ...").

@@ -57,7 +57,7 @@ struct SolidSpec {
   double level_spacing_mm = 0.1;  // Δ
   int regions_x = 4, regions_y = 4;
   double chord_tol_mm = 0.001;    // polygonisation of the cylinder's circle
-  bool strictly_simple = true;    // ask Clipper for strictly simple output (no touching vertices)
+  bool strictly_simple = false;   // ask Clipper for strictly simple output (no touching vertices)
 };
 
 // One tool movement to remove: the shape must outlive the call.
