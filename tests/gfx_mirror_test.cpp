@@ -60,7 +60,7 @@ TEST(GfxExchange, PublishRefusedUntilTakenAndNothingIsLost) {
   ASSERT_TRUE(ex.take(snap));
   EXPECT_EQ(snap.version, 1u);
   std::set<int> got;
-  for (const auto& c : snap.cells) got.insert(c.region);
+  for (std::size_t i = 0; i < snap.cell_count; ++i) got.insert(snap.cells[i].region);
   EXPECT_EQ(got, first);
   EXPECT_FALSE(ex.take(snap));  // nothing new
   mirror.receive(snap);

@@ -143,6 +143,7 @@ class Geometry {
       batches_.store(batches_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     }
     if (n > 0) {
+      last_rx_ns_ = rx_[n - 1];
       const std::int64_t t = sched::now_ns();
       for (std::size_t i = 0; i < n; ++i) lag_.record(t - rx_[i]);
       applied_.store(applied_.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
@@ -150,6 +151,23 @@ class Geometry {
     }
     return n;
   }
+
+  // Rendering: tip points go to the exchange's path buffer (no allocation).
+  void set_exchange(gfx::SolidExchange* ex) noexcept { ex_ = ex; }
+  // Publishes the solid to the render side between batches (never waits; see
+  // gfx/exchange.hpp). Tools: one per channel that has a position and a cutting tool.
+  bool publish(const gfx::LiveStats& stats) noexcept {
+    if (ex_ == nullptr) return false;
+    std::array<gfx::ToolState, gfx::kMaxTools> tools{};
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < ch_.size() && n < tools.size(); ++i) {
+      const Channel& c = ch_[i];
+      if (!c.have || c.shape == nullptr) continue;
+      tools[n++] = gfx::tool_state(c.shape->tool, 1, geom::Pose{c.last, {0, 0, 1}}, static_cast<int>(i));
+    }
+    return ex_->publish(solid_, std::span<const gfx::ToolState>(tools.data(), n), last_id_, stats);
+  }
+  [[nodiscard]] std::int64_t last_rx_ns() const noexcept { return last_rx_ns_; }
 
   void publish_volume() noexcept {
     ticks_since_volume_ = 0;
@@ -204,6 +222,7 @@ class Geometry {
       return;
     }
     if (p == c.last) return;  // standing still
+    if (ex_ != nullptr) ex_->add_path_point(p);
     if (c.run.size() >= 2) {
       // Replace the run's straight sweep run[0]→last by run[0]→p only if every sample of
       // the run stays within the tolerance of the longer sweep: geometry stays exact.
@@ -219,7 +238,10 @@ class Geometry {
   void flush(Channel& c) noexcept {
     if (c.run.size() < 2) return;
     geom::Pose from{c.run.front(), {0, 0, 1}}, to{c.run.back(), {0, 0, 1}};
-    if (c.shape != nullptr) batch_.push_back({c.shape, from, to, static_cast<geom::MoveId>(c.seq & 0xFFFFFFFFU)});
+    if (c.shape != nullptr) {
+      last_id_ = static_cast<geom::MoveId>(c.seq & 0xFFFFFFFFU);
+      batch_.push_back({c.shape, from, to, last_id_});
+    }
     const geom::Vec3 end = c.run.back();
     c.run.clear();
     c.run.push_back(end);
@@ -238,6 +260,9 @@ class Geometry {
   std::atomic<std::uint64_t> applied_{0}, sweeps_{0}, batches_{0};
   std::atomic<double> removed_{0.0};
   int ticks_since_volume_ = 0;
+  gfx::SolidExchange* ex_ = nullptr;
+  geom::MoveId last_id_ = 0;
+  std::int64_t last_rx_ns_ = 0;
 };
 
 void write_record_line(std::FILE* f, const hal::RawRecord& r, const std::string& iface) {
@@ -293,6 +318,9 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
 
   RingSink sink(ring, rec_ring.get(), cfg, backpressure, stop);
   Geometry geo(r.solid, shapes, cfg.tool, ring, cfg.merge_tolerance_mm);
+  geo.set_exchange(opt.exchange);
+  if (opt.on_start) opt.on_start(r.solid);
+  r.solid.clear_dirty();  // the render side starts from this state
 
   std::atomic<bool> hal_done{false}, rec_done{false};
   std::atomic<int> hal_mode{-1};
@@ -307,14 +335,36 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
   std::atomic<bool> geo_running{true};
   std::atomic<int> geo_mode{-1};
   const std::int64_t idle_ns = static_cast<std::int64_t>(cfg.geometry_idle_us) * 1000;
+  // Counters for the HUD, filled by the geometry thread when it publishes (reads of
+  // counters other threads own are relaxed atomics, as in the status line).
+  auto live_stats = [&] {
+    gfx::LiveStats st;
+    st.live = true;
+    const std::int64_t now = sched::now_ns();
+    st.lag_ms = geo.last_rx_ns() > 0 ? static_cast<double>(now - geo.last_rx_ns()) * 1e-6 : 0.0;
+    st.samples = geo.applied();
+    st.sample_rate_hz = now > t0 ? static_cast<double>(sink.received()) / (static_cast<double>(now - t0) * 1e-9) : 0.0;
+    st.ring_high_water = ring.high_water();
+    st.ring_capacity = ring.capacity();
+    st.ring_overruns = ring.overruns();
+    st.decode_errors = src->counters().total() + sink.counters().total();
+    st.realtime = hal_mode.load(std::memory_order_relaxed) == 1 && geo_mode.load(std::memory_order_relaxed) == 1;
+    return st;
+  };
   std::thread geometry([&] {
     geo_mode = sched::configure_current_thread(cfg.geometry_thread) == sched::RtMode::Fifo ? 1 : 0;
     for (;;) {
       const bool finished = hal_done.load(std::memory_order_acquire);
-      if ((finished || !backpressure || ring.size() >= chunk) && geo.tick(chunk) > 0) continue;
+      if ((finished || !backpressure || ring.size() >= chunk) && geo.tick(chunk) > 0) {
+        if (opt.exchange != nullptr) (void)geo.publish(live_stats());
+        continue;
+      }
       if (finished && ring.front() == nullptr) break;
       sched::sleep_until_ns(sched::now_ns() + idle_ns);
     }
+    // The final state must reach the render side: retry while it is busy (bounded: 2 s).
+    for (int i = 0; opt.exchange != nullptr && i < 1000 && !geo.publish(live_stats()); ++i)
+      sched::sleep_until_ns(sched::now_ns() + 2'000'000);
     geo.publish_volume();
     geo_running.store(false, std::memory_order_release);
   });

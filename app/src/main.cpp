@@ -2,6 +2,9 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <future>
+#include <optional>
+#include <thread>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -15,6 +18,7 @@
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "app/view.hpp"
+#include "gfx/viewer.hpp"
 #include "gfx/window.hpp"
 #include "nc/emulator.hpp"
 
@@ -186,6 +190,12 @@ struct RunOptions {
   std::string profile, out = "lbrsim-out";
   app::LiveOptions live;
   bool quiet = false;
+  // rendering (gfx/): a viewer window when a display exists, screenshots on request
+  bool no_window = false, hidden = false;
+  int screenshot_every = 0;
+  std::string screenshot_prefix = "lbrsim-frame-";
+  std::string view = "iso", color = "heat", size = "1280x800";
+  double rate_hz = 0.0;  // 0: the profile's [render] rate_hz
 };
 
 std::atomic<bool> g_stop{false};
@@ -201,7 +211,72 @@ int run_live_command(const RunOptions& o) {
   spdlog::info("run: source {}, profile {}, period {} ms", o.live.source, profile.source, profile.live.period_ms);
   app::StatusFn status;
   if (!o.quiet) status = [](const std::string& line) { spdlog::info("{}", line); };
-  const app::LiveResult r = app::run_live(profile, o.live, g_stop, status);
+
+  // Rendering: a window (visible, or hidden for screenshots only) when a display exists.
+  const bool want_render = o.screenshot_every > 0 || (!o.no_window && gfx::display_available());
+  if (o.screenshot_every > 0 && !gfx::display_available())
+    throw gfx::DisplayError("--screenshot-every needs an X or Wayland display for its hidden OpenGL window, and "
+                            "neither DISPLAY nor WAYLAND_DISPLAY is set. Run it under a virtual X server: "
+                            "`xvfb-run -a lbrsim run ...`");
+  std::optional<app::LiveResult> result;
+  if (!want_render) {
+    result.emplace(app::run_live(profile, o.live, g_stop, status));
+  } else {
+    gfx::RenderThreadConfig rc;
+    rc.rate_hz = o.rate_hz > 0 ? o.rate_hz : profile.render_rate_hz;
+    rc.view = gfx::parse_view(o.view);
+    rc.ortho = rc.view == gfx::StandardView::Top;
+    rc.render.color = gfx::parse_color_mode(o.color);
+    gfx::parse_size(o.size, rc.width, rc.height);
+    rc.screenshot_every = o.screenshot_every;
+    rc.screenshot_prefix = o.screenshot_prefix;
+    const bool visible = !o.hidden && !o.no_window;
+    gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source);
+    gfx::SolidExchange ex(1 << 14);
+    // The live run goes on its own thread; the main thread owns the window's events.
+    std::promise<std::unique_ptr<geom::LbrSolid>> initial;
+    auto initial_ready = initial.get_future();
+    app::LiveOptions lo = o.live;
+    lo.exchange = &ex;
+    lo.on_start = [&initial](const geom::LbrSolid& s) { initial.set_value(std::make_unique<geom::LbrSolid>(s)); };
+    std::exception_ptr live_error;
+    std::atomic<bool> live_done{false};
+    std::thread live([&] {
+      try {
+        result.emplace(app::run_live(profile, lo, g_stop, status));
+      } catch (...) {
+        live_error = std::current_exception();
+        try {
+          initial.set_value(nullptr);
+        } catch (...) {  // already set
+        }
+      }
+      live_done.store(true);
+    });
+    std::unique_ptr<geom::LbrSolid> start = initial_ready.get();
+    if (start) {
+      gfx::RenderThread rt(win, ex, *start, rc);
+      start.reset();
+      rt.start();
+      if (visible) {
+        gfx::run_event_loop(win, rt, [&] { return !live_done.load(); });
+      } else {
+        while (!live_done.load() && rt.running()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      // Show the final state for one more frame period before closing.
+      std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(2000.0 / rc.rate_hz)));
+      rt.stop();
+      const gfx::PacingReport& rep = rt.report();
+      if (!rep.error.empty()) spdlog::warn("render thread stopped: {}", rep.error);
+      spdlog::info("render: {} frames ({} late), period p50 {:.2f} p99 {:.2f} max {:.2f} ms, {} screenshots", rep.frames,
+                   rep.late_frames, gfx::PacingReport::percentile(rep.period_ms, 0.5),
+                   gfx::PacingReport::percentile(rep.period_ms, 0.99), gfx::PacingReport::percentile(rep.period_ms, 1.0),
+                   rep.screenshots);
+    }
+    live.join();
+    if (live_error) std::rethrow_exception(live_error);
+  }
+  const app::LiveResult& r = *result;
   app::write_live_outputs(o.out, r, profile);
   std::uint64_t errors = 0;
   for (const auto& [k, v] : r.decode_errors) errors += v;
@@ -304,6 +379,21 @@ int main(int argc, char** argv) {
   run->add_option("--out", ro.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
   run->add_option("--record", ro.live.record, "Record the raw input to this file (candump -l format)");
   run->add_flag("--quiet", ro.quiet, "No status lines");
+  run->add_flag("--no-window", ro.no_window, "Do not open the viewer even when a display exists");
+  run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
+  run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "
+                  "headless: xvfb-run -a)")->check(CLI::Range(0, 1000000));
+  run->add_option("--screenshot-prefix", ro.screenshot_prefix, "Screenshot file prefix (PREFIX000123.png)")
+      ->capture_default_str();
+  run->add_option("--view", ro.view, "Camera: top, front, side or iso")
+      ->check(CLI::IsMember({"top", "front", "side", "iso"}))
+      ->capture_default_str();
+  run->add_option("--color", ro.color, "Colour mode: plain, heat or regions")
+      ->check(CLI::IsMember({"plain", "heat", "regions"}))
+      ->capture_default_str();
+  run->add_option("--size", ro.size, "Window / screenshot size WxH [px]")->capture_default_str();
+  run->add_option("--render-rate", ro.rate_hz, "Render rate [Hz] (default: the profile's [render] rate_hz, 30)")
+      ->check(CLI::Range(1.0, 240.0));
 
   EmulateOptions em;
   CLI::App* emu = cli.add_subcommand("emulate", "Run a part program through the machine emulator and write its samples");

@@ -357,6 +357,11 @@ Profile parse_profile(const std::string& text, const std::string& name) {
     }
   }
   read_live(top, p, name);
+  if (const toml::table* rt = top.table("render")) {
+    Section s(*rt, "render", name);
+    p.render_rate_hz = s.number("rate_hz", 30.0, 1.0, 240.0, "Hz");
+    s.reject_unknown();
+  }
   top.reject_unknown();
   return p;
 }

@@ -53,7 +53,7 @@ bool SolidExchange::publish(geom::LbrSolid& solid, std::span<const ToolState> to
       u.level = l;
       u.cell = solid.cell(r, l);  // copy-assign: reuses the slot's capacity
     }
-  s.cells.resize(n);
+  s.cell_count = n;
   s.path.clear();
   std::swap(s.path, path_);  // both reserved to path_capacity_: the writer keeps a reserved buffer
   if (path_.capacity() < path_capacity_) path_.reserve(path_capacity_);
@@ -72,6 +72,8 @@ bool SolidExchange::publish(geom::LbrSolid& solid, std::span<const ToolState> to
 bool SolidExchange::take(Snapshot& out) noexcept {
   if (state_.load(std::memory_order_acquire) != kFull) return false;
   std::swap(out.cells, slot_.cells);
+  out.cell_count = slot_.cell_count;
+  slot_.cell_count = 0;
   std::swap(out.path, slot_.path);
   out.tools = slot_.tools;
   out.tool_count = slot_.tool_count;

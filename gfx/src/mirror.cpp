@@ -14,13 +14,17 @@ MeshMirror::MeshMirror(const geom::LbrSolid& initial, const mesh::MeshOptions& o
 
 void MeshMirror::receive(Snapshot& s) {
   ++receives_;
-  for (CellUpdate& u : s.cells) {
+  // Copy (not move) the cells: the snapshot's storage goes back to the writer with its
+  // capacity, and the memory freed later here was allocated on this thread.
+  const std::size_t n = std::min(s.cell_count, s.cells.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const CellUpdate& u = s.cells[i];
     if (u.region < 0 || u.region >= solid_.regions() || u.level < 0 || u.level >= solid_.levels()) continue;
     auto& p = pending_[static_cast<std::size_t>(u.region)];
     if (p.empty()) pending_since_[static_cast<std::size_t>(u.region)] = receives_;
-    p[u.level] = std::move(u.cell);
+    p[u.level] = u.cell;
   }
-  s.cells.clear();
+  s.cell_count = 0;
 }
 
 int MeshMirror::pending_regions() const noexcept {

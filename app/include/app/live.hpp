@@ -18,6 +18,7 @@
 
 #include "app/profile.hpp"
 #include "geom/lbr_solid.hpp"
+#include "gfx/exchange.hpp"
 #include "nc/emulator.hpp"
 #include "nc/toolpath.hpp"
 
@@ -28,6 +29,11 @@ struct LiveOptions {
   double speed = 1.0;     // replay/emulator: 1 = real time, 0 = as fast as possible
   std::string record;     // write the raw input to this file (candump -l format)
   double status_period_s = 1.0;
+  // Rendering (docs/rendering.md §7). When set, the geometry thread publishes to the
+  // exchange after every batch (never waiting) and records tip positions for the path;
+  // `on_start` receives the solid before any thread starts (the render side's initial copy).
+  gfx::SolidExchange* exchange = nullptr;
+  std::function<void(const geom::LbrSolid&)> on_start;
 };
 
 struct LiveResult {

@@ -36,6 +36,7 @@ struct Profile {
   int batch_moves = 64;     // moves per subtract() call in batch mode
   int threads = 0;          // batch-mode kernel threads (0 = one per hardware thread)
   std::map<int, geom::Tool> tools;
+  double render_rate_hz = 30.0;  // [render] rate_hz: the render thread's fixed frame rate
   hal::LiveConfig live;     // [live], [[live.axis]], [threads]: `lbrsim run` (docs/profiles.md)
 };
 

@@ -61,7 +61,11 @@ inline constexpr int kMaxTools = 4;
 
 struct Snapshot {
   std::uint64_t version = 0;           // publish count (1, 2, …)
-  std::vector<CellUpdate> cells;       // cells changed since the previous snapshot
+  // Cells changed since the previous snapshot: the first `cell_count` entries. The vector
+  // never shrinks, so its Cell objects keep their capacity when the buffers travel back to
+  // the writer (the geometry thread then copies into existing storage instead of allocating).
+  std::vector<CellUpdate> cells;
+  std::size_t cell_count = 0;
   std::vector<geom::Vec3> path;        // tool tip points since the previous snapshot, oldest first
   std::array<ToolState, kMaxTools> tools{};
   int tool_count = 0;

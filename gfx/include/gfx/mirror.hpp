@@ -39,7 +39,8 @@ class MeshMirror {
   // (before its first publish), and builds every region's mesh (setup; allocates).
   MeshMirror(const geom::LbrSolid& initial, const mesh::MeshOptions& opt = {});
 
-  // Moves the snapshot's cells into the pending sets (the newest version of a cell wins).
+  // Copies the snapshot's cells into the pending sets (the newest version of a cell wins)
+  // and marks the snapshot's cells consumed (cell_count = 0; storage kept for reuse).
   void receive(Snapshot& s);
   // Brings at most `max_regions` visible pending regions up to date (all when <= 0).
   StepStats step(const std::function<bool(int region)>& visible, int max_regions);
