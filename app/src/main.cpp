@@ -268,10 +268,18 @@ int run_live_command(const RunOptions& o) {
       rt.stop();
       const gfx::PacingReport& rep = rt.report();
       if (!rep.error.empty()) spdlog::warn("render thread stopped: {}", rep.error);
-      spdlog::info("render: {} frames ({} late), period p50 {:.2f} p99 {:.2f} max {:.2f} ms, {} screenshots", rep.frames,
-                   rep.late_frames, gfx::PacingReport::percentile(rep.period_ms, 0.5),
-                   gfx::PacingReport::percentile(rep.period_ms, 0.99), gfx::PacingReport::percentile(rep.period_ms, 1.0),
-                   rep.screenshots);
+      using P = gfx::PacingReport;
+      const std::vector<double> rebuilt(rep.regions_rebuilt.begin(), rep.regions_rebuilt.end());
+      double rebuilt_sum = 0;
+      for (double v : rebuilt) rebuilt_sum += v;
+      spdlog::info("render: {} frames ({} late) at {} Hz | period p50 {:.2f} p99 {:.2f} max {:.2f} ms | work p50 {:.2f} "
+                   "p99 {:.2f} ms | mesh p99 {:.2f} ms | regions rebuilt per frame mean {:.2f} max {:.0f} | {} "
+                   "screenshots | {}",
+                   rep.frames, rep.late_frames, rc.rate_hz, P::percentile(rep.period_ms, 0.5),
+                   P::percentile(rep.period_ms, 0.99), P::percentile(rep.period_ms, 1.0), P::percentile(rep.work_ms, 0.5),
+                   P::percentile(rep.work_ms, 0.99), P::percentile(rep.mesh_ms, 0.99),
+                   rep.frames ? rebuilt_sum / static_cast<double>(rep.frames) : 0.0, P::percentile(rebuilt, 1.0),
+                   rep.screenshots, rep.gl);
     }
     live.join();
     if (live_error) std::rethrow_exception(live_error);
