@@ -82,6 +82,7 @@ void run_event_loop(Window& win, RenderThread& rt, const std::function<bool()>& 
   int fw = 0, fh = 0;
   glfwGetFramebufferSize(w, &fw, &fh);
   in.h = fh > 0 ? fh : 1;
+  if (fw > 0 && fh > 0) rt.resize(fw, fh);  // the framebuffer may differ from the window size (HiDPI)
   glfwSetWindowUserPointer(w, &in);
   glfwSetMouseButtonCallback(w, on_button);
   glfwSetCursorPosCallback(w, on_cursor);
