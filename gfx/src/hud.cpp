@@ -78,6 +78,7 @@ void Hud::draw(const std::string& text, int w, int h, float scale) {
   }
   longest = std::max(longest, cur);
   const float pw = 6.0f * static_cast<float>(longest) + 8.0f, ph = 12.0f * static_cast<float>(lines) + 4.0f;
+  scale = std::clamp(static_cast<float>(w) / pw, 1.0f, scale);  // fit narrow viewports
   const std::uint8_t bg[4] = {10, 12, 16, 170};
   for (auto [x, y] : {std::pair{0.0f, 0.0f}, {pw, 0.0f}, {pw, ph}, {0.0f, ph}}) {
     FontVertex v{x, y, 0, {bg[0], bg[1], bg[2], bg[3]}};

@@ -43,8 +43,21 @@ Window::Window(int width, int height, bool visible, const std::string& title) : 
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   glfwWindowHint(GLFW_VISIBLE, visible ? GLFW_TRUE : GLFW_FALSE);
-  glfwWindowHint(GLFW_SAMPLES, 4);
+  // 4x multisampling on visible windows with a hardware renderer; a software rasteriser
+  // (llvmpipe) pays for every sample, so the window is recreated without it there.
+  glfwWindowHint(GLFW_SAMPLES, visible ? 4 : 0);
   w_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  if (w_ && visible) {
+    glfwMakeContextCurrent(w_);
+    const auto* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const std::string renderer = r ? r : "";
+    if (renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos) {
+      glfwMakeContextCurrent(nullptr);
+      glfwDestroyWindow(w_);
+      glfwWindowHint(GLFW_SAMPLES, 0);
+      w_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+    }
+  }
   if (!w_) {
     if (g_windows == 0) glfwTerminate();
     throw std::runtime_error("cannot create an OpenGL 3.3 core context: " + g_last_error);
