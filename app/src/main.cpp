@@ -1,6 +1,7 @@
 // lbrsim — command-line entry point. Subcommands: batch, emulate, profile.
 #include <cstdio>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -69,6 +70,47 @@ int run_emulate_command(const EmulateOptions& o) {
   return 0;
 }
 
+void print_result(const app::BatchResult& r, const BatchOptions& o) {
+  std::printf("removed %.3f mm3 of %.3f mm3 | machining %.2f s | simulated in %.3f s (factor %.5f) | "
+              "%d levels x %d regions (%dx%d), %zu vertices\n",
+              r.removed_volume_mm3, r.stock_volume_mm3, r.machining_time_s, r.wall_time_s,
+              r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0, r.solid.levels(), r.solid.regions(),
+              r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
+  std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
+  app::write_mesh_files(r.solid, o.stl, o.ply);
+  if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
+  if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
+}
+
+// A profile with [[channel]] tables: every channel runs its own program; the sweeps are
+// merged by time (docs/machine-kinds.md#several-channels).
+int run_channels_command(const BatchOptions& o, const app::Profile& profile) {
+  if (!o.program.empty())
+    throw std::runtime_error("--program: profile " + profile.source +
+                             " defines [[channel]] tables; their programs come from channel.program");
+  const std::string dir = std::filesystem::path(profile.source).parent_path().string();
+  std::vector<app::ChannelPath> channels;
+  std::string names;
+  for (const app::Channel& c : profile.channels) {
+    if (c.program.empty()) throw std::runtime_error(profile.source + ": channel '" + c.name + "' has no program");
+    const std::filesystem::path prog = std::filesystem::path(c.program).is_absolute()
+                                           ? std::filesystem::path(c.program)
+                                           : std::filesystem::path(dir) / c.program;
+    app::Profile per = profile;
+    per.g54_origin_mm = c.g54_origin_mm;
+    channels.push_back({c.name, app::load_toolpath(prog.string(), per, interpreter_of(o.interpreter)), c.kin});
+    spdlog::info("channel {}: program {} ({} segments)", c.name, prog.string(), channels.back().path.segments.size());
+    names += (names.empty() ? "" : "+") + c.name;
+  }
+  app::Progress progress;
+  if (!o.quiet) progress = [](double f) { spdlog::info("progress {:5.1f} %", 100.0 * f); };
+  const app::BatchResult r = app::run_batch_channels(profile, channels, o.sampled, progress);
+  app::write_batch_outputs(o.out, r, profile, names);
+  std::printf("%zu channels (%s)%s\n", channels.size(), names.c_str(), o.sampled ? ", sampled" : "");
+  print_result(r, o);
+  return 0;
+}
+
 int run_batch_command(const BatchOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
   if (!o.stock.empty()) app::apply_stock_override(profile, o.stock);
@@ -76,6 +118,7 @@ int run_batch_command(const BatchOptions& o) {
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
 
+  if (!profile.channels.empty()) return run_channels_command(o, profile);
   nc::Toolpath path =
       o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   const std::string program = o.program.empty() ? path.source : o.program;
@@ -99,15 +142,7 @@ int run_batch_command(const BatchOptions& o) {
   app::BatchResult r = app::run_batch(profile, path, progress);
   if (emulated) r.machining_time_s = emulated_time_s;
   app::write_batch_outputs(o.out, r, profile, program);
-  std::printf("removed %.3f mm3 of %.3f mm3 | machining %.2f s | simulated in %.3f s (factor %.5f) | "
-              "%d levels x %d regions (%dx%d), %zu vertices\n",
-              r.removed_volume_mm3, r.stock_volume_mm3, r.machining_time_s, r.wall_time_s,
-              r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0, r.solid.levels(), r.solid.regions(),
-              r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
-  std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
-  app::write_mesh_files(r.solid, o.stl, o.ply);
-  if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
-  if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
+  print_result(r, o);
   return 0;
 }
 

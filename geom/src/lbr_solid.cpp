@@ -250,18 +250,18 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
   std::size_t i = 0;
   while (i < batch.size()) {
     const SweepRef& first = batch[i];
-    if (first.shape == nullptr) {
+    if (first.shape == nullptr && first.turning == nullptr) {
       ++i;
       continue;
     }
     SweepRef merged = first;
-    const double tol = 0.5 * first.shape->chord_tol_mm;
+    const double tol = 0.5 * (first.shape != nullptr ? first.shape->chord_tol_mm : first.turning->chord_tol_mm);
     std::size_t j = i + 1;
     // Extend the run while the next move continues this one with the same tool and a fixed
     // axis, and every intermediate point stays within tol/2 of the merged chord.
     while (j < batch.size() && j - i < kMaxRun) {
       const SweepRef& n = batch[j];
-      if (n.shape != first.shape || !(n.from.tip == merged.to.tip) || !same_axis(n.from.axis, first.from.axis) ||
+      if (n.shape != first.shape || n.turning != first.turning || !(n.from.tip == merged.to.tip) || !same_axis(n.from.axis, first.from.axis) ||
           !same_axis(n.to.axis, first.from.axis) || !same_axis(first.to.axis, first.from.axis))
         break;
       bool ok = true;
@@ -281,13 +281,24 @@ SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int lev
   SubtractStats stats;
   merge_collinear(batch, ws.merged);
   ws.sweeps.clear();
+  ws.sweep_id.clear();
+  ws.lathe.clear();
+  ws.lathe_id.clear();
   double zlo = INFINITY, zhi = -INFINITY;
   for (const SweepRef& s : ws.merged) {
+    if (s.turning != nullptr) {
+      ws.lathe.emplace_back(*s.turning, s.from.tip.x, s.from.tip.z, s.to.tip.x, s.to.tip.z);
+      ws.lathe_id.push_back(s.id);
+      zlo = std::min(zlo, ws.lathe.back().z_min());
+      zhi = std::max(zhi, ws.lathe.back().z_max());
+      continue;
+    }
     ws.sweeps.emplace_back(*s.shape, s.from, s.to);
+    ws.sweep_id.push_back(s.id);
     zlo = std::min(zlo, ws.sweeps.back().z_min());
     zhi = std::max(zhi, ws.sweeps.back().z_max());
   }
-  if (ws.sweeps.empty() || zhi < z0_ || zlo > z1_) return stats;
+  if ((ws.sweeps.empty() && ws.lathe.empty()) || zhi < z0_ || zlo > z1_) return stats;
   const int lb = std::max(level_begin, level_at(zlo));
   const int le = std::min(level_end, level_at(zhi) + 1);
   for (int l = lb; l < le; ++l) stats += subtract_level(l, ws);
@@ -308,7 +319,18 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
     sw.section(zc, ws.sections, ws.scratch);
     for (std::size_t k = before; k < ws.sections.size(); ++k) {
       ws.section_box.push_back(bounds_of(ws.sections[k]));
-      ws.section_id.push_back(ws.merged[si].id);
+      ws.section_id.push_back(ws.sweep_id[si]);
+      all.add(ws.section_box.back());
+    }
+  }
+  for (std::size_t si = 0; si < ws.lathe.size(); ++si) {
+    const LatheSweep& lw = ws.lathe[si];
+    if (zc < lw.z_min() || zc > lw.z_max()) continue;
+    const std::size_t before = ws.sections.size();
+    lw.section(zc, xy_, ws.sections);
+    for (std::size_t k = before; k < ws.sections.size(); ++k) {
+      ws.section_box.push_back(bounds_of(ws.sections[k]));
+      ws.section_id.push_back(ws.lathe_id[si]);
       all.add(ws.section_box.back());
     }
   }

@@ -198,6 +198,7 @@ class Interpreter {
       case MachineKind::Mill3: return a <= Z;
       case MachineKind::MillRotary: return true;
       case MachineKind::Lathe: return a == X || a == Z;
+      case MachineKind::LatheC: return a == X || a == Y || a == Z || a == C;
     }
     return false;
   }
@@ -206,6 +207,7 @@ class Interpreter {
       case MachineKind::Mill3: return "mill3 has X Y Z";
       case MachineKind::MillRotary: return "mill-rotary has X Y Z A B C";
       case MachineKind::Lathe: return "lathe has X Z";
+      case MachineKind::LatheC: return "lathe-c has X Y Z C";
     }
     return "?";
   }
@@ -354,7 +356,7 @@ class Interpreter {
     if (gw[kUnits]) scale_ = code10(*gw[kUnits]) == 200 ? kInch : 1.0;
     // kCutter: G40 (compensation off) is the only state the interpreter has.
     if (gw[kLathe]) {
-      if (opt_.machine != MachineKind::Lathe)
+      if (opt_.machine != MachineKind::Lathe && opt_.machine != MachineKind::LatheC)
         fail("'" + gw[kLathe]->text + "' (lathe " + (code10(*gw[kLathe]) == 70 ? "diameter" : "radius") +
              " mode) needs machine kind lathe");
       diameter_mode_ = code10(*gw[kLathe]) == 70;
@@ -647,7 +649,7 @@ class Interpreter {
   int wcs_ = 0;
   double scale_ = 1.0;  // mm per program length unit
   bool absolute_ = true, arc_absolute_ = false, inverse_time_ = false, retract_to_initial_ = true;
-  bool diameter_mode_ = false;
+  bool diameter_mode_ = opt_.diameter_mode;
   Plane plane_ = Plane::XY;
   int motion_ = -1;  // code x 10; -1: none (G80 or program start)
   double feed_ = 0.0;
