@@ -152,11 +152,24 @@ void run_moves(const Profile& profile, const std::vector<TimedMove>& moves, Batc
   std::vector<geom::SweepRef> batch;
   batch.reserve(static_cast<std::size_t>(profile.batch_moves));
   auto last_report = t0;
+  // Within one subtract() call the order of the sweeps does not matter (their union is
+  // removed), so a batch is grouped by channel: each channel's consecutive sampled moves
+  // then merge into long sweeps (merge_collinear) instead of alternating with the others'.
+  std::size_t begin = 0;
+  std::vector<const TimedMove*> group;
+  auto flush = [&](std::size_t end) {
+    group.clear();
+    for (std::size_t k = begin; k < end; ++k) group.push_back(&moves[k]);
+    std::stable_sort(group.begin(), group.end(),
+                     [](const TimedMove* a, const TimedMove* b) { return a->channel < b->channel; });
+    for (const TimedMove* m : group) batch.push_back(m->ref);
+    if (!batch.empty()) r.stats += r.solid.subtract(batch);
+    batch.clear();
+    begin = end;
+  };
   for (std::size_t i = 0; i < moves.size(); ++i) {
-    batch.push_back(moves[i].ref);
-    if (static_cast<int>(batch.size()) >= profile.batch_moves) {
-      r.stats += r.solid.subtract(batch);
-      batch.clear();
+    if (static_cast<int>(i + 1 - begin) >= profile.batch_moves) {
+      flush(i + 1);
       if (progress) {
         const auto now = std::chrono::steady_clock::now();
         if (now - last_report > std::chrono::seconds(1)) {
@@ -166,7 +179,7 @@ void run_moves(const Profile& profile, const std::vector<TimedMove>& moves, Batc
       }
     }
   }
-  if (!batch.empty()) r.stats += r.solid.subtract(batch);
+  flush(moves.size());
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.removed_volume_mm3 = r.stock_volume_mm3 - r.solid.volume_mm3();
   if (progress) progress(1.0);

@@ -323,15 +323,35 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
       all.add(ws.section_box.back());
     }
   }
-  for (std::size_t si = 0; si < ws.lathe.size(); ++si) {
-    const LatheSweep& lw = ws.lathe[si];
-    if (zc < lw.z_min() || zc > lw.z_max()) continue;
-    const std::size_t before = ws.sections.size();
-    lw.section(zc, xy_, ws.sections);
-    for (std::size_t k = before; k < ws.sections.size(); ++k) {
-      ws.section_box.push_back(bounds_of(ws.sections[k]));
-      ws.section_id.push_back(ws.lathe_id[si]);
-      all.add(ws.section_box.back());
+  // Turning moves: the union of their revolved regions on this level is one region, the
+  // smallest r_min (external) and the largest r_max (internal); it takes the latest move id
+  // among them.
+  if (!ws.lathe.empty()) {
+    double r_out = INFINITY, r_in = -INFINITY, tol = spec_.chord_tol_mm;
+    MoveId id_out = 0, id_in = 0;
+    for (std::size_t si = 0; si < ws.lathe.size(); ++si) {
+      const LatheSweep& lw = ws.lathe[si];
+      double lo = 0, hi = 0;
+      if (zc < lw.z_min() || zc > lw.z_max() || !lw.interval(zc, lo, hi)) continue;
+      tol = lw.chord_tol_mm();
+      if (lw.internal()) {
+        if (hi > r_in) r_in = hi;
+        id_in = std::max(id_in, ws.lathe_id[si]);
+      } else {
+        if (lo < r_out) r_out = lo;
+        id_out = std::max(id_out, ws.lathe_id[si]);
+      }
+    }
+    for (int internal = 0; internal < 2; ++internal) {
+      const double r = internal ? r_in : r_out;
+      if (!std::isfinite(r)) continue;
+      const std::size_t before = ws.sections.size();
+      LatheSweep::removed_region(r, internal != 0, tol, xy_, ws.sections);
+      for (std::size_t k = before; k < ws.sections.size(); ++k) {
+        ws.section_box.push_back(bounds_of(ws.sections[k]));
+        ws.section_id.push_back(internal ? id_in : id_out);
+        all.add(ws.section_box.back());
+      }
     }
   }
   stats.sections = ws.sections.size();

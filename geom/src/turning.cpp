@@ -175,9 +175,13 @@ std::size_t LatheSweep::section(double z, const Rect& extent, Paths& out) const 
   double lo = 0, hi = 0;
   if (extent.empty() || !interval(z, lo, hi)) return 0;
   const bool inside = shape_->tool.internal;
-  const double r = inside ? hi : lo;
+  return removed_region(inside ? hi : lo, inside, shape_->chord_tol_mm, extent, out);
+}
+
+std::size_t LatheSweep::removed_region(double r, bool inside, double tol, const Rect& extent, Paths& out) {
+  if (extent.empty()) return 0;
   auto circle = [&](double rad, bool ccw) {
-    const int n = Sweep::circle_segments(rad, shape_->chord_tol_mm);
+    const int n = Sweep::circle_segments(rad, tol);
     const double rho = rad * 2.0 / (1.0 + std::cos(std::numbers::pi / n));
     Path c;
     c.reserve(static_cast<std::size_t>(n));

@@ -85,6 +85,11 @@ class LatheSweep {
   // counter-clockwise circle of radius r_max. Circles are polygonised like tool sections
   // (boundary within ±tol/2). Returns the number of paths appended.
   std::size_t section(double z_mm, const Rect& extent, Paths& out) const;
+  // The same region for a given radius: external (r_min, `internal` false) or internal
+  // (r_max). Used to emit one region for many turning moves on a level: the union of
+  // {r >= r_i} is {r >= min r_i}, of {r <= r_i} it is {r <= max r_i}.
+  static std::size_t removed_region(double r_mm, bool internal, double chord_tol_mm, const Rect& extent, Paths& out);
+  [[nodiscard]] double chord_tol_mm() const noexcept { return shape_->chord_tol_mm; }
 
  private:
   const TurningShape* shape_;
