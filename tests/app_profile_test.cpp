@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "app/batch.hpp"
+#include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "nc/movelist.hpp"
 
@@ -106,4 +107,20 @@ TEST(Batch, RunsAMoveListAndReportsMachiningTime) {
   } catch (const std::runtime_error& e) {
     EXPECT_STREQ(e.what(), "t.moves:2: tool 4 is not in the tool table of p.toml");
   }
+}
+
+TEST(Batch, WorkerThreadsGiveTheSameSolid) {
+  // The level pool must reproduce the single-threaded result cell for cell.
+  app::Profile p = app::default_profile();
+  const nc::Toolpath tp = app::demo_toolpath();
+  p.threads = 1;
+  const app::BatchResult one = app::run_batch(p, tp);
+  p.threads = 3;
+  const app::BatchResult three = app::run_batch(p, tp);
+  EXPECT_EQ(one.threads, 1);
+  EXPECT_EQ(three.threads, 3);
+  EXPECT_DOUBLE_EQ(one.removed_volume_mm3, three.removed_volume_mm3);
+  EXPECT_EQ(one.solid.vertex_count(), three.solid.vertex_count());
+  EXPECT_EQ(one.stats.cells_changed, three.stats.cells_changed);
+  EXPECT_EQ(one.solid.dirty_count(), three.solid.dirty_count());
 }

@@ -11,6 +11,10 @@ PACKAGES=(
   libglfw3-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
+  # libFuzzer decoder targets (tools/test.sh builds them with clang)
+  clang
+  # HIL bench (tools/hil/hil-bench.sh): VM with Debian's kernel, vcan, busybox initramfs
+  qemu-system-x86 busybox-static cpio
   # LinuxCNC's rs274 interpreter: optional at run time (lbrsim --interpreter rs274), needed for
   # the rs274 cross-check tests (they skip without it)
   linuxcnc-uspace

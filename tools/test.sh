@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # One command for a newcomer and for CI: install dependencies, build, run every test;
 # then rebuild with AddressSanitizer + UndefinedBehaviorSanitizer and run the unit tests
-# again (build-asan/). Set LBR_SKIP_SANITIZERS=1 to skip the second stage locally.
+# again (build-asan/); then the threaded tests (ring, RT threads, live pipeline) under
+# ThreadSanitizer (build-tsan/) and,
+# where clang is installed, the libFuzzer decoder targets for a fixed number of runs
+# (build-fuzz/, label fuzz). Set LBR_SKIP_SANITIZERS=1 to skip these stages locally.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/setup-debian.sh
@@ -15,4 +18,21 @@ if [ "${LBR_SKIP_SANITIZERS:-0}" != "1" ]; then
   cmake --build build-asan --parallel "$(nproc)"
   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
     ctest --test-dir build-asan --output-on-failure --parallel "$(nproc)" --timeout 900 -L unit
+fi
+
+if [ "${LBR_SKIP_SANITIZERS:-0}" != "1" ]; then
+  echo "== sanitizers: thread (ring, RT threads, live pipeline) =="
+  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DLBR_SANITIZE=thread -DLBR_TSAN_TESTS=ON \
+        -DLBR_BUILD_BENCH=OFF -DLBR_BUILD_TESTS=ON
+  cmake --build build-tsan --parallel "$(nproc)" --target sched_ring_test sched_ring_test_tsan sched_stats_test app_live_test
+  TSAN_OPTIONS=halt_on_error=1 ctest --test-dir build-tsan --output-on-failure --timeout 900 \
+        -R '^(SpscRing|LatencyHistogram|RtThread|PeriodicThread|LiveRun|LiveProfile)\.|^sched_ring_test_tsan$'
+  if command -v clang++ >/dev/null 2>&1; then
+    echo "== fuzzers (libFuzzer, fixed runs) =="
+    CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLBR_BUILD_FUZZ=ON \
+          -DLBR_SANITIZE=fuzzer-no-link,address,undefined \
+          -DLBR_BUILD_BENCH=OFF -DLBR_BUILD_TESTS=ON
+    cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_serial fuzz_candump
+    ctest --test-dir build-fuzz --output-on-failure -L fuzz -R '^fuzz_(serial|candump)$'
+  fi
 fi

@@ -1,5 +1,7 @@
 #include "app/batch.hpp"
 
+#include "app/level_pool.hpp"
+
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -148,6 +150,8 @@ geom::SolidSpec solid_spec(const Profile& profile, const Tooling& tooling) {
 
 // Subtracts the moves in order, profile.batch_moves at a time.
 void run_moves(const Profile& profile, const std::vector<TimedMove>& moves, BatchResult& r, const Progress& progress) {
+  LevelPool pool(profile.threads);
+  r.threads = pool.threads();
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<geom::SweepRef> batch;
   batch.reserve(static_cast<std::size_t>(profile.batch_moves));
@@ -163,7 +167,7 @@ void run_moves(const Profile& profile, const std::vector<TimedMove>& moves, Batc
     std::stable_sort(group.begin(), group.end(),
                      [](const TimedMove* a, const TimedMove* b) { return a->channel < b->channel; });
     for (const TimedMove* m : group) batch.push_back(m->ref);
-    if (!batch.empty()) r.stats += r.solid.subtract(batch);
+    if (!batch.empty()) r.stats += pool.subtract(r.solid, batch);
     batch.clear();
     begin = end;
   };
@@ -205,7 +209,7 @@ double machining_time_s(const Profile& profile, const nc::Toolpath& path) {
 BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress) {
   Tooling tooling;
   tooling.need_all(profile, path);
-  BatchResult r{geom::LbrSolid(solid_spec(profile, tooling)), 0, 0, 0, 0, 0, {}};
+  BatchResult r{geom::LbrSolid(solid_spec(profile, tooling)), 0, 0, 0, 0, 0, {}, 1};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
   r.machining_time_s = machining_time_s(profile, path);
   std::vector<TimedMove> moves;
@@ -218,7 +222,7 @@ BatchResult run_batch_channels(const Profile& profile, const std::vector<Channel
                                const Progress& progress) {
   Tooling tooling;
   for (const ChannelPath& c : channels) tooling.need_all(profile, c.path);
-  BatchResult r{geom::LbrSolid(solid_spec(profile, tooling)), 0, 0, 0, 0, 0, {}};
+  BatchResult r{geom::LbrSolid(solid_spec(profile, tooling)), 0, 0, 0, 0, 0, {}, 1};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
   const nc::EmulatorLimits limits = emulator_limits(profile);
   std::vector<TimedMove> moves;

@@ -1,6 +1,8 @@
-// lbrsim — command-line entry point. Subcommands: batch, emulate, profile.
-#include <cstdio>
+// lbrsim — command-line entry point. Subcommands: batch, run, emulate, profile.
+#include <atomic>
 #include <cmath>
+#include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -10,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "app/batch.hpp"
+#include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "nc/emulator.hpp"
@@ -27,6 +30,7 @@ struct BatchOptions {
   std::string stl, ply;  // mesh exports (empty: none)
   std::vector<std::string> tools;
   double level_spacing = 0.0;
+  int threads = -1;
   bool quiet = false;
   bool sampled = false;
 };
@@ -117,6 +121,7 @@ int run_batch_command(const BatchOptions& o) {
   for (const std::string& t : o.tools) app::apply_tool_override(profile, t);
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
+  if (o.threads >= 0) profile.threads = o.threads;
 
   if (!profile.channels.empty()) return run_channels_command(o, profile);
   nc::Toolpath path =
@@ -143,6 +148,40 @@ int run_batch_command(const BatchOptions& o) {
   if (emulated) r.machining_time_s = emulated_time_s;
   app::write_batch_outputs(o.out, r, profile, program);
   print_result(r, o);
+  return 0;
+}
+
+struct RunOptions {
+  std::string profile, out = "lbrsim-out";
+  app::LiveOptions live;
+  bool quiet = false;
+};
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop.store(true); }
+
+int run_live_command(const RunOptions& o) {
+  const app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  spdlog::info("run: source {}, profile {}, period {} ms", o.live.source, profile.source, profile.live.period_ms);
+  app::StatusFn status;
+  if (!o.quiet) status = [](const std::string& line) { spdlog::info("{}", line); };
+  const app::LiveResult r = app::run_live(profile, o.live, g_stop, status);
+  app::write_live_outputs(o.out, r, profile);
+  std::uint64_t errors = 0;
+  for (const auto& [k, v] : r.decode_errors) errors += v;
+  std::printf("%s | received %llu applied %llu lost %llu | ring overruns %llu high water %llu | decode errors %llu | "
+              "lag p50 %.3f p99 %.3f max %.3f ms | removed %.3f mm3 | rt %s%s\n",
+              r.source.c_str(), static_cast<unsigned long long>(r.samples_received),
+              static_cast<unsigned long long>(r.samples_applied), static_cast<unsigned long long>(r.samples_lost),
+              static_cast<unsigned long long>(r.ring_overruns), static_cast<unsigned long long>(r.ring_high_water),
+              static_cast<unsigned long long>(errors), r.lag_p50_ms, r.lag_p99_ms, r.lag_max_ms, r.removed_volume_mm3,
+              r.rt_mode.c_str(), g_stop.load() ? " | stopped by signal" : "");
+  std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
   return 0;
 }
 
@@ -177,10 +216,25 @@ int main(int argc, char** argv) {
       ->take_all();
   batch->add_option("--level-spacing", b.level_spacing, "Level spacing Δ [mm]")->check(CLI::Range(0.001, 1000.0));
   batch->add_option("--regions", b.regions, "Region grid NXxNY (e.g. 4x4) or auto");
+  batch->add_option("--threads", b.threads, "Kernel worker threads (0 = one per hardware thread; default: profile)")
+      ->check(CLI::Range(0, 256));
   batch->add_option("--out", b.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
   batch->add_flag("--quiet", b.quiet, "No progress messages");
   batch->add_option("--stl", b.stl, "Also write the reconstructed part as binary STL to this file");
   batch->add_option("--ply", b.ply, "Also write the reconstructed part as binary PLY (with normals, move id) to this file");
+
+  RunOptions ro;
+  CLI::App* run = cli.add_subcommand("run", "Simulate live from a machine (CAN, serial), a log replay or the emulator");
+  run->add_option("--source", ro.live.source,
+                  "can:IFACE | serial:DEVICE | replay:LOGFILE | emulator:PROGRAM (PROGRAM 'demo' = bundled demo)")
+      ->required();
+  run->add_option("--profile", ro.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
+  run->add_option("--speed", ro.live.speed, "Replay/emulator pacing: 1 = real time, 0 = as fast as possible")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  run->add_option("--out", ro.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
+  run->add_option("--record", ro.live.record, "Record the raw input to this file (candump -l format)");
+  run->add_flag("--quiet", ro.quiet, "No status lines");
 
   EmulateOptions em;
   CLI::App* emu = cli.add_subcommand("emulate", "Run a part program through the machine emulator and write its samples");
@@ -204,6 +258,7 @@ int main(int argc, char** argv) {
 
   try {
     if (batch->parsed()) return run_batch_command(b);
+    if (run->parsed()) return run_live_command(ro);
     if (emu->parsed()) return run_emulate_command(em);
     if (prof->parsed()) {
       if (print_default) {

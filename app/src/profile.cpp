@@ -9,6 +9,8 @@
 
 #include <toml++/toml.h>
 
+#include "hal/sample.hpp"
+
 #include "default_profile.inc"  // kDefaultProfileToml, generated from config/profiles/default-mill3.toml
 
 namespace lbr::app {
@@ -187,6 +189,88 @@ std::vector<double> split_numbers(const std::string& s, const std::string& what)
   return out;
 }
 
+int axis_index(Section& s, const toml::table& t) {
+  const std::string a = s.string("axis", "");
+  static const char* kNames[] = {"X", "Y", "Z", "A", "B", "C"};
+  for (int i = 0; i < 6; ++i)
+    if (a == kNames[i]) return i;
+  s.fail(t.get("axis"), "axis", "expected one of X, Y, Z, A, B, C; got '" + a + "'");
+}
+
+sched::RtConfig thread_config(Section& s, const std::string& prefix, sched::RtConfig c) {
+  c.priority = static_cast<int>(s.integer(prefix + "_priority", c.priority, 0, 99));
+  c.cpu = static_cast<int>(s.integer(prefix + "_cpu", c.cpu, -1, 1023));
+  return c;
+}
+
+void read_live(Section& top, Profile& p, const std::string& name) {
+  hal::LiveConfig& L = p.live;
+  if (const toml::table* lt = top.table("live")) {
+    Section s(*lt, "live", name);
+    L.period_ms = s.number("period_ms", 1.0, 0.05, 1000.0, "ms");
+    L.tool = static_cast<int>(s.integer("tool", 1, 0, 9999));
+    L.ring_capacity = static_cast<std::size_t>(s.integer("ring_capacity", 4096, 16, 1 << 22));
+    L.geometry_idle_us = static_cast<int>(s.integer("geometry_idle_us", 1000, 10, 100000));
+    L.jump_tolerance = s.number("jump_tolerance", 1.5, 1.0, 100.0, "factor");
+    L.merge_tolerance_mm = s.number("merge_tolerance_mm", 0.001, 0.0, 1.0, "mm");
+    if (const toml::table* st = s.table("serial")) {
+      Section ss(*st, "live.serial", name);
+      L.serial.baud = static_cast<int>(ss.integer("baud", 115200, 1200, 4000000));
+      ss.reject_unknown();
+    }
+    if (const toml::table* ct = s.table("can")) {
+      Section cs(*ct, "live.can", name);
+      L.can.sync_id = static_cast<std::uint32_t>(cs.integer("sync_id", 0x080, 0, 0x7FF));
+      L.can.tpdo_base = static_cast<std::uint32_t>(cs.integer("tpdo_base", 0x180, 0, 0x7FF - 127));
+      L.can.sync_counter_max = static_cast<int>(cs.integer("sync_counter_max", 240, 2, 255));
+      L.can.late_ms = cs.number("late_ms", 0.0, 0.0, 1000.0, "ms");
+      L.can.reconnect_ms = cs.number("reconnect_ms", 500.0, 1.0, 60000.0, "ms");
+      cs.reject_unknown();
+    }
+    if (const toml::node* an = s.get("axis")) {
+      const toml::array* arr = an->as_array();
+      if (arr == nullptr) s.fail(an, "axis", "expected an array of tables [[live.axis]]");
+      for (const toml::node& e : *arr) {
+        if (!e.is_table()) s.fail(&e, "axis", "expected [[live.axis]] tables");
+        const toml::table& t = *e.as_table();
+        Section as(t, "live.axis", name);
+        hal::AxisMap m;
+        m.axis = axis_index(as, t);
+        m.name = as.string("name", std::string(1, "XYZABC"[m.axis]));
+        m.channel = static_cast<int>(as.integer("channel", 0, 0, hal::kMaxChannels - 1));
+        m.node = static_cast<int>(as.integer("node", m.axis + 1, 1, 127));
+        m.index = static_cast<int>(as.integer("index", m.axis, 0, 15));
+        m.scale = as.number("scale", 0.001, -1e6, 1e6, "mm or deg per count");
+        if (m.scale == 0.0) as.fail(t.get("scale"), "scale", "must not be 0");
+        m.offset = as.number("offset", 0.0, -1e9, 1e9, "mm or deg");
+        m.min = as.number("min", -1e6, -1e9, 1e9, "mm or deg");
+        m.max = as.number("max", 1e6, -1e9, 1e9, "mm or deg");
+        if (!(m.min < m.max)) as.fail(t.get("max"), "max", "must be greater than min");
+        m.max_speed_per_s = as.number("max_speed_per_min", 0.0, 0.0, 1e7, "mm/min or deg/min") / 60.0;
+        as.reject_unknown();
+        for (const hal::AxisMap& o : L.axes) {
+          if (o.channel == m.channel && o.axis == m.axis)
+            as.fail(t.get("axis"), "axis", "channel " + std::to_string(m.channel) + " axis " + m.name + " is mapped twice");
+          if (o.node == m.node) as.fail(t.get("node"), "node", "CAN node " + std::to_string(m.node) + " is mapped twice");
+          if (o.index == m.index && o.channel == m.channel)
+            as.fail(t.get("index"), "index", "serial index " + std::to_string(m.index) + " is mapped twice");
+        }
+        L.axes.push_back(m);
+      }
+    }
+    s.reject_unknown();
+  }
+  if (L.axes.empty()) L.axes = hal::default_axes();
+  if (const toml::table* tt = top.table("threads")) {
+    Section s(*tt, "threads", name);
+    L.hal_thread = thread_config(s, "hal", L.hal_thread);
+    L.geometry_thread = thread_config(s, "geometry", L.geometry_thread);
+    const bool lock = s.boolean("lock_memory", true);
+    L.hal_thread.lock_memory = L.geometry_thread.lock_memory = lock;
+    s.reject_unknown();
+  }
+}
+
 }  // namespace
 
 void apply_regions(Profile& p, const std::string& spec, const std::string& where) {
@@ -303,7 +387,12 @@ Profile parse_profile(const std::string& text, const std::string& name) {
     p.solid.level_spacing_mm = s.number("level_spacing_mm", 0.1, 0.001, 1000.0, "mm");
     p.solid.chord_tol_mm = s.number("chord_tolerance_mm", 0.001, 0.0001, 1.0, "mm");
     p.batch_moves = static_cast<int>(s.integer("batch_moves", 64, 1, 100000));
-    p.solid.strictly_simple = true;
+    p.threads = static_cast<int>(s.integer("threads", 0, 0, 256));
+    if (const toml::node* ss = s.get("strictly_simple")) {
+      const auto v = ss->value_exact<bool>();
+      if (!v) s.fail(ss, "strictly_simple", "expected true or false");
+      p.solid.strictly_simple = *v;
+    }
     if (const toml::node* r = s.get("regions")) {
       const auto v = r->value_exact<std::string>();
       if (!v) s.fail(r, "regions", "expected a string \"NXxNY\" or \"auto\"");
@@ -343,7 +432,7 @@ Profile parse_profile(const std::string& text, const std::string& name) {
       if (p.kin.kind != kin::MachineKind::LatheC && mount != kin::Mount::Spindle)
         s.fail(e.as_table()->get("live"), "live", "only for machine kind lathe-c");
       p.tools[number] = t;
-      p.live[number] = mount;
+      p.live_mounts[number] = mount;
     }
   }
 
@@ -380,6 +469,7 @@ Profile parse_profile(const std::string& text, const std::string& name) {
       p.channels.push_back(std::move(c));
     }
   }
+  read_live(top, p, name);
   top.reject_unknown();
   return p;
 }
@@ -398,8 +488,8 @@ Profile default_profile() { return parse_profile(kDefaultProfileToml, "<built-in
 
 kin::Mount Profile::mount_of(int tool) const {
   if (inserts.count(tool)) return kin::Mount::Turning;
-  const auto it = live.find(tool);
-  return it != live.end() ? it->second : kin::Mount::Spindle;
+  const auto it = live_mounts.find(tool);
+  return it != live_mounts.end() ? it->second : kin::Mount::Spindle;
 }
 
 nc::GcodeOptions gcode_options(const Profile& p, const Channel& c) {

@@ -277,7 +277,7 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
 }
 
 SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
-                                        SubtractWorkspace& ws) {
+                                        SubtractWorkspace& ws, int stride) {
   SubtractStats stats;
   merge_collinear(batch, ws.merged);
   ws.sweeps.clear();
@@ -299,9 +299,12 @@ SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int lev
     zhi = std::max(zhi, ws.sweeps.back().z_max());
   }
   if ((ws.sweeps.empty() && ws.lathe.empty()) || zhi < z0_ || zlo > z1_) return stats;
-  const int lb = std::max(level_begin, level_at(zlo));
+  stride = std::max(stride, 1);
+  int lb = level_begin;
+  const int first = level_at(zlo);
+  if (lb < first) lb += (first - lb + stride - 1) / stride * stride;
   const int le = std::min(level_end, level_at(zhi) + 1);
-  for (int l = lb; l < le; ++l) stats += subtract_level(l, ws);
+  for (int l = lb; l < le; l += stride) stats += subtract_level(l, ws);
   return stats;
 }
 

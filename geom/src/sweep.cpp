@@ -287,14 +287,30 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
     }
     return emit(sc.hull, out);
   }
+  // Several disks (ramps): only vertices whose value in their own grid direction comes
+  // close to the union's support value in that direction can be hull vertices. The support
+  // function of the union is D-Lipschitz in the direction (D bounds |p - centre|), and a
+  // vertex is extreme for some direction within ±π/n of its own, so a vertex below
+  // S_k - 2·D·π/n is strictly inside; dropping those leaves the hull unchanged and the sort
+  // small.
+  double cx = 0.0, cy = 0.0;
+  for (const auto& d : sc.disks) cx += d.x, cy += d.y;
+  cx /= static_cast<double>(sc.disks.size());
+  cy /= static_cast<double>(sc.disks.size());
+  double dmax = 0.0;
+  for (const auto& d : sc.disks) dmax = std::max(dmax, std::hypot(d.x - cx, d.y - cy) + d.r * grow);
+  const double slack = 2.0 * dmax * std::numbers::pi / n + 1e-12;
   sc.pts.clear();
-  for (const auto& d : sc.disks) {
-    if (d.r <= 0.0) {
-      sc.pts.push_back({d.x, d.y});
-      continue;
+  for (int k = 0; k < n; ++k) {
+    const double ux = sc.cos_t[k], uy = sc.sin_t[k];
+    double best = -INFINITY;
+    for (const auto& d : sc.disks) best = std::max(best, (d.x - cx) * ux + (d.y - cy) * uy + d.r * grow);
+    for (const auto& d : sc.disks) {
+      const double v = (d.x - cx) * ux + (d.y - cy) * uy + d.r * grow;
+      if (v < best - slack) continue;
+      const double rho = d.r * grow;
+      sc.pts.push_back({d.x + rho * ux, d.y + rho * uy});
     }
-    const double rho = d.r * grow;
-    for (int k = 0; k < n; ++k) sc.pts.push_back({d.x + rho * sc.cos_t[k], d.y + rho * sc.sin_t[k]});
   }
   convex_hull(sc.pts, sc.hull);
   return emit(sc.hull, out);

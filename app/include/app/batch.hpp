@@ -21,6 +21,7 @@ struct BatchResult {
   double wall_time_s = 0;       // kernel time only (excluding parsing and output)
   std::uint64_t moves = 0;      // motion segments
   geom::SubtractStats stats;
+  int threads = 1;              // kernel worker threads used
 };
 
 // Progress callback: fraction done in [0, 1].

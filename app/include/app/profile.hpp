@@ -11,6 +11,7 @@
 #include "geom/tool.hpp"
 #include "geom/turning.hpp"
 #include "kin/kinematics.hpp"
+#include "hal/config.hpp"
 #include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
 
@@ -45,12 +46,14 @@ struct Profile {
   geom::SolidSpec solid;    // stock, Δ, region grid, chord tolerance
   bool regions_auto = false;
   int batch_moves = 64;     // moves per subtract() call in batch mode
+  int threads = 0;          // batch-mode kernel threads (0 = one per hardware thread)
   std::map<int, geom::Tool> tools;             // milling tools (spindle or live tools)
+  hal::LiveConfig live;     // [live], [[live.axis]], [threads]: `lbrsim run` (docs/profiles.md)
   // Machine kinematics ([machine] kind, rotary, ... in docs/profiles.md).
   kin::Kinematics kin;
   bool diameter_programming = true;            // lathe kinds: X words are diameters (G7)
   std::map<int, geom::TurningTool> inserts;    // turning tools (lathe kinds), same numbering
-  std::map<int, kin::Mount> live;      // lathe-c: how each milling tool is mounted
+  std::map<int, kin::Mount> live_mounts;       // lathe-c: how each milling tool is mounted
   std::vector<Channel> channels;               // empty: one channel, the program given
   // Mount of tool n on this machine (Spindle on mills).
   [[nodiscard]] kin::Mount mount_of(int tool) const;

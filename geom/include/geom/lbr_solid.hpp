@@ -56,7 +56,7 @@ struct SolidSpec {
   double level_spacing_mm = 0.1;  // Δ
   int regions_x = 4, regions_y = 4;
   double chord_tol_mm = 0.001;    // polygonisation of the cylinder's circle
-  bool strictly_simple = true;    // ask Clipper for strictly simple output (no touching vertices)
+  bool strictly_simple = false;   // ask Clipper for strictly simple output (no touching vertices)
 };
 
 // One tool movement to remove: the shape must outlive the call. Either a milling tool
@@ -119,8 +119,10 @@ class LbrSolid {
   SubtractStats subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws);
   // Same, for the levels [level_begin, level_end) only. Levels are independent, so callers
   // may run disjoint level ranges on several threads, each with its own workspace.
+  // `stride` > 1 takes every stride-th level from level_begin (interleaving balances the
+  // load when threads share one batch).
   SubtractStats subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
-                                SubtractWorkspace& ws);
+                                SubtractWorkspace& ws, int stride = 1);
 
   // 3D boolean difference with another LBR solid (the paper's OpBool): every level of this
   // solid loses the polygons of the other solid's level that contains the same mid-plane

@@ -1,0 +1,440 @@
+#include "app/live.hpp"
+
+#include <algorithm>
+#include <cinttypes>
+#include <filesystem>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app/batch.hpp"
+#include "app/outputs.hpp"
+#include "geom/serialize.hpp"
+#include "hal/source.hpp"
+#include "hal/validate.hpp"
+#include "sched/rt_thread.hpp"
+#include "sched/spsc_ring.hpp"
+
+namespace lbr::app {
+
+namespace {
+
+using hal::AxisSample;
+
+// ---- emulator source: the nc machine emulator at the live sample period ----
+class EmulatorGenerator final : public hal::SampleGenerator {
+ public:
+  EmulatorGenerator(const nc::Toolpath& path, const nc::EmulatorLimits& limits) : emu_(path, limits) {}
+  bool next(std::array<double, hal::kMaxAxes>& q, int& tool) noexcept override {
+    nc::Sample s;
+    if (!emu_.next(s)) return false;
+    for (std::size_t a = 0; a < q.size(); ++a) q[a] = s.axes[a];
+    tool = s.tool;
+    return true;
+  }
+
+ private:
+  nc::Emulator emu_;
+};
+
+std::unique_ptr<hal::Source> make_source(const Profile& profile, const LiveOptions& opt) {
+  const auto colon = opt.source.find(':');
+  if (colon == std::string::npos || colon + 1 >= opt.source.size())
+    throw std::runtime_error("--source '" + opt.source + "': expected can:IF, serial:DEV, replay:FILE or emulator:PROGRAM");
+  const std::string kind = opt.source.substr(0, colon), arg = opt.source.substr(colon + 1);
+  if (kind == "can") return hal::make_socketcan_source(arg, profile.live);
+  if (kind == "serial") return hal::make_serial_source(arg, profile.live);
+  if (kind == "replay") return hal::make_replay_source(arg, profile.live, opt.speed);
+  if (kind == "emulator") {
+    const nc::Toolpath path = arg == "demo" ? demo_toolpath() : load_toolpath(arg, profile);
+    for (const nc::Segment& sg : path.segments)
+      if (sg.tool != 0 && !profile.tools.count(sg.tool))
+        throw std::runtime_error(path.source + ":" + std::to_string(sg.line) + ": tool " + std::to_string(sg.tool) +
+                                 " is not in the tool table of " + profile.source);
+    return hal::make_generator_source(std::make_unique<EmulatorGenerator>(path, live_emulator_limits(profile)), arg,
+                                      profile.live, opt.speed);
+  }
+  throw std::runtime_error("--source '" + opt.source + "': unknown kind '" + kind + "' (can, serial, replay, emulator)");
+}
+
+// HAL side: validation, then the ring. Runs on the HAL thread.
+class RingSink final : public hal::SampleSink {
+ public:
+  RingSink(sched::SpscRing<AxisSample>& ring, sched::SpscRing<hal::RawRecord>* rec, const hal::LiveConfig& cfg,
+           bool backpressure, const std::atomic<bool>& stop)
+      : ring_(ring), rec_(rec), validator_(cfg), backpressure_(backpressure), stop_(stop) {}
+
+  void on_samples(std::span<const AxisSample> samples) noexcept override {
+    for (const AxisSample& s : samples) {
+      received_.store(received_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      if (!validator_.accept(s, counters_)) {
+        rejected_.store(rejected_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+        continue;
+      }
+      if (backpressure_) {
+        // Not a live source: wait for room rather than drop (never counts an overrun).
+        while (ring_.size() >= ring_.capacity()) {
+          if (stop_.load(std::memory_order_relaxed)) return;
+          sched::sleep_until_ns(sched::now_ns() + 100'000);
+        }
+      }
+      (void)ring_.try_push(s);  // a refused push is counted by the ring (ring_overruns)
+    }
+  }
+  void on_raw(const hal::RawRecord& r) noexcept override {
+    if (rec_ != nullptr && !rec_->try_push(r))
+      rec_overruns_.store(rec_overruns_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  }
+  [[nodiscard]] std::uint64_t received() const noexcept { return received_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t rejected() const noexcept { return rejected_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t rec_overruns() const noexcept { return rec_overruns_.load(std::memory_order_relaxed); }
+  [[nodiscard]] const hal::Counters& counters() const noexcept { return counters_; }
+
+ private:
+  sched::SpscRing<AxisSample>& ring_;
+  sched::SpscRing<hal::RawRecord>* rec_;
+  hal::Validator validator_;
+  bool backpressure_;
+  const std::atomic<bool>& stop_;
+  hal::Counters counters_;
+  std::atomic<std::uint64_t> received_{0}, rejected_{0}, rec_overruns_{0};
+};
+
+// Geometry side: drains the ring, merges straight runs per channel, subtracts.
+class Geometry {
+ public:
+  static constexpr std::size_t kMaxRun = 256;
+
+  // `shapes`: every tool of the profile; `default_tool` cuts for samples without a tool
+  // number. Tool numbers without a shape (0 = empty spindle) cut nothing.
+  Geometry(geom::LbrSolid& solid, const std::map<int, geom::CutterShape>& shapes, int default_tool,
+           sched::SpscRing<AxisSample>& ring, double tol_mm)
+      : solid_(solid), shapes_(shapes), ring_(ring), tol_(tol_mm) {
+    const auto it = shapes_.find(default_tool);
+    default_shape_ = it == shapes_.end() ? nullptr : &it->second;
+    const std::size_t cap = ring.capacity();
+    batch_.reserve(cap + hal::kMaxChannels);
+    rx_.resize(cap);
+    for (Channel& c : ch_) c.run.reserve(kMaxRun + 1);
+  }
+
+  // Applies what is in the ring, at most `limit` samples; returns the samples applied.
+  std::size_t tick(std::size_t limit) noexcept {
+    batch_.clear();
+    std::size_t n = 0;
+    limit = std::min(limit, rx_.size());
+    while (n < limit) {
+      AxisSample* s = ring_.front();
+      if (s == nullptr) break;
+      take(*s);
+      rx_[n++] = s->t_rx_ns;
+      ring_.pop();
+    }
+    for (Channel& c : ch_) flush(c);
+    if (!batch_.empty()) {
+      solid_.subtract(batch_, ws_);
+      sweeps_.store(sweeps_.load(std::memory_order_relaxed) + batch_.size(), std::memory_order_relaxed);
+      batches_.store(batches_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    }
+    if (n > 0) {
+      const std::int64_t t = sched::now_ns();
+      for (std::size_t i = 0; i < n; ++i) lag_.record(t - rx_[i]);
+      applied_.store(applied_.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
+      if (++ticks_since_volume_ >= 50) publish_volume();
+    }
+    return n;
+  }
+
+  void publish_volume() noexcept {
+    ticks_since_volume_ = 0;
+    removed_.store(solid_.initial_volume_mm3() - solid_.volume_mm3(), std::memory_order_relaxed);
+  }
+  [[nodiscard]] std::uint64_t applied() const noexcept { return applied_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t sweeps() const noexcept { return sweeps_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t batches() const noexcept { return batches_.load(std::memory_order_relaxed); }
+  [[nodiscard]] double removed_mm3() const noexcept { return removed_.load(std::memory_order_relaxed); }
+  [[nodiscard]] const sched::LatencyHistogram& lag() const noexcept { return lag_; }
+
+ private:
+  struct Channel {
+    bool have = false;
+    geom::Vec3 last{};               // latest position (end of the pending run)
+    const geom::CutterShape* shape = nullptr;  // tool of the pending run (nullptr: cuts nothing)
+    std::vector<geom::Vec3> run;     // run[0] = start of the pending sweep, then its samples
+    std::uint64_t seq = 0;
+  };
+
+  // Distance of p from the segment a–b [mm].
+  static double dist_to_segment(geom::Vec3 p, geom::Vec3 a, geom::Vec3 b) noexcept {
+    const geom::Vec3 d = b - a;
+    const double dd = geom::dot(d, d);
+    const double t = dd > 0 ? std::clamp(geom::dot(p - a, d) / dd, 0.0, 1.0) : 0.0;
+    return geom::norm(p - geom::lerp(a, b, t));
+  }
+
+  void take(const AxisSample& s) noexcept {
+    if (s.channel >= hal::kMaxChannels) return;
+    Channel& c = ch_[s.channel];
+    geom::Vec3 p = c.last;
+    if (s.mask & 1U) p.x = s.q[0];
+    if (s.mask & 2U) p.y = s.q[1];
+    if (s.mask & 4U) p.z = s.q[2];
+    c.seq = s.seq;
+    const geom::CutterShape* shape = default_shape_;
+    if (s.tool >= 0) {
+      const auto it = shapes_.find(s.tool);  // no allocation
+      shape = it == shapes_.end() ? nullptr : &it->second;
+    }
+    if (c.have && shape != c.shape) {  // tool change: the pending run belongs to the old tool
+      flush(c);
+      c.shape = shape;
+    }
+    if (!c.have) {  // first sample: where the tool is; nothing to cut yet
+      c.have = true;
+      c.shape = shape;
+      c.last = p;
+      c.run.clear();
+      c.run.push_back(p);
+      return;
+    }
+    if (p == c.last) return;  // standing still
+    if (c.run.size() >= 2) {
+      // Replace the run's straight sweep run[0]→last by run[0]→p only if every sample of
+      // the run stays within the tolerance of the longer sweep: geometry stays exact.
+      bool straight = c.run.size() < kMaxRun;
+      for (std::size_t i = 1; straight && i < c.run.size(); ++i)
+        straight = dist_to_segment(c.run[i], c.run[0], p) <= tol_;
+      if (!straight) flush(c);
+    }
+    c.run.push_back(p);
+    c.last = p;
+  }
+
+  void flush(Channel& c) noexcept {
+    if (c.run.size() < 2) return;
+    geom::Pose from{c.run.front(), {0, 0, 1}}, to{c.run.back(), {0, 0, 1}};
+    if (c.shape != nullptr) batch_.push_back({c.shape, from, to, static_cast<geom::MoveId>(c.seq & 0xFFFFFFFFU)});
+    const geom::Vec3 end = c.run.back();
+    c.run.clear();
+    c.run.push_back(end);
+  }
+
+  geom::LbrSolid& solid_;
+  const std::map<int, geom::CutterShape>& shapes_;
+  const geom::CutterShape* default_shape_ = nullptr;
+  sched::SpscRing<AxisSample>& ring_;
+  double tol_;
+  geom::SubtractWorkspace ws_;
+  std::vector<geom::SweepRef> batch_;
+  std::vector<std::int64_t> rx_;
+  std::array<Channel, hal::kMaxChannels> ch_;
+  sched::LatencyHistogram lag_;
+  std::atomic<std::uint64_t> applied_{0}, sweeps_{0}, batches_{0};
+  std::atomic<double> removed_{0.0};
+  int ticks_since_volume_ = 0;
+};
+
+void write_record_line(std::FILE* f, const hal::RawRecord& r, const std::string& iface) {
+  char line[256];
+  if (r.serial) {
+    const long long sec = r.t_wall_ns / 1'000'000'000, usec = (r.t_wall_ns % 1'000'000'000) / 1000;
+    int n = std::snprintf(line, sizeof line, "(%lld.%06lld) serial #", sec, usec);
+    for (std::uint16_t i = 0; i < r.len && n + 3 < static_cast<int>(sizeof line); ++i)
+      n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), "%02X", r.bytes[i]);
+    std::fputs(line, f);
+    std::fputc('\n', f);
+  } else {
+    hal::CanFrame fr = r.frame;
+    fr.t_ns = r.t_wall_ns;
+    const std::size_t n = hal::format_candump_line(fr, iface, line);
+    std::fwrite(line, 1, n, f);
+  }
+}
+
+}  // namespace
+
+LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::atomic<bool>& stop, const StatusFn& status) {
+  const hal::LiveConfig& cfg = profile.live;
+  const auto tool = profile.tools.find(cfg.tool);
+  if (tool == profile.tools.end())
+    throw std::runtime_error(profile.source + ": live.tool " + std::to_string(cfg.tool) + " is not in the tool table");
+  std::map<int, geom::CutterShape> shapes;
+  double dmax = 1.0;
+  for (const auto& [n, t] : profile.tools) {
+    shapes.emplace(n, geom::CutterShape::build(t, profile.solid.chord_tol_mm));
+    dmax = std::max(dmax, t.diameter_mm);
+  }
+  geom::SolidSpec spec = profile.solid;
+  if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, dmax);
+  LiveResult r{geom::LbrSolid(spec), opt.source, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, {}, 0, 0, 0, 0, 0, 0, ""};
+  r.stock_volume_mm3 = r.solid.initial_volume_mm3();
+
+  std::unique_ptr<hal::Source> src = make_source(profile, opt);
+  src->open();
+  const bool backpressure = !src->live();
+
+  sched::SpscRing<AxisSample> ring(cfg.ring_capacity);
+  std::unique_ptr<sched::SpscRing<hal::RawRecord>> rec_ring;
+  std::FILE* rec_file = nullptr;
+  if (!opt.record.empty()) {
+    rec_file = std::fopen(opt.record.c_str(), "w");
+    if (rec_file == nullptr) throw std::runtime_error(opt.record + ": cannot open for writing");
+    rec_ring = std::make_unique<sched::SpscRing<hal::RawRecord>>(1 << 15);
+    src->set_recording(true);
+  }
+  std::string rec_iface = "can0";
+  if (opt.source.rfind("can:", 0) == 0) rec_iface = opt.source.substr(4);
+
+  RingSink sink(ring, rec_ring.get(), cfg, backpressure, stop);
+  Geometry geo(r.solid, shapes, cfg.tool, ring, cfg.merge_tolerance_mm);
+
+  std::atomic<bool> hal_done{false}, rec_done{false};
+  std::atomic<int> hal_mode{-1};
+  std::atomic<std::uint64_t> source_lost{0};
+  const std::int64_t t0 = sched::now_ns();
+
+  // Geometry thread: apply whatever is in the ring at once; when it was empty, look again
+  // after geometry_idle_us (so a sample waits at most that long before work starts).
+  // Sources that are not live (replay/emulator as fast as possible) are applied in chunks
+  // of exactly lbr.batch_moves samples, so such a run is reproducible bit for bit.
+  const std::size_t chunk = backpressure ? static_cast<std::size_t>(profile.batch_moves) : ring.capacity();
+  std::atomic<bool> geo_running{true};
+  std::atomic<int> geo_mode{-1};
+  const std::int64_t idle_ns = static_cast<std::int64_t>(cfg.geometry_idle_us) * 1000;
+  std::thread geometry([&] {
+    geo_mode = sched::configure_current_thread(cfg.geometry_thread) == sched::RtMode::Fifo ? 1 : 0;
+    for (;;) {
+      const bool finished = hal_done.load(std::memory_order_acquire);
+      if ((finished || !backpressure || ring.size() >= chunk) && geo.tick(chunk) > 0) continue;
+      if (finished && ring.front() == nullptr) break;
+      sched::sleep_until_ns(sched::now_ns() + idle_ns);
+    }
+    geo.publish_volume();
+    geo_running.store(false, std::memory_order_release);
+  });
+  std::thread hal_thread([&] {
+    hal_mode = sched::configure_current_thread(cfg.hal_thread) == sched::RtMode::Fifo ? 1 : 0;
+    while (!stop.load(std::memory_order_relaxed)) {
+      const hal::PollResult pr = src->poll(50, sink);
+      source_lost.store(src->lost(), std::memory_order_relaxed);  // the source is this thread's
+      if (pr == hal::PollResult::End) break;
+      if (pr == hal::PollResult::Error) sched::sleep_until_ns(sched::now_ns() + 1'000'000);  // no busy loop
+    }
+    hal_done.store(true, std::memory_order_release);
+  });
+  std::thread recorder;
+  if (rec_ring) {
+    recorder = std::thread([&] {
+      for (;;) {
+        const bool finished = hal_done.load(std::memory_order_acquire);
+        bool any = false;
+        while (hal::RawRecord* rec = rec_ring->front()) {
+          write_record_line(rec_file, *rec, rec_iface);
+          rec_ring->pop();
+          any = true;
+        }
+        if (finished && !any) break;
+        if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+    });
+  }
+
+  auto snapshot = [&] {
+    r.samples_received = sink.received();
+    r.samples_applied = geo.applied();
+    r.samples_rejected = sink.rejected();
+    r.ring_overruns = ring.overruns();
+    r.ring_high_water = ring.high_water();
+    r.samples_lost = source_lost.load(std::memory_order_relaxed) + r.samples_rejected + r.ring_overruns;
+    const auto& lag = geo.lag();
+    r.lag_p50_ms = static_cast<double>(lag.percentile_ns(0.5)) * 1e-6;
+    r.lag_p99_ms = static_cast<double>(lag.percentile_ns(0.99)) * 1e-6;
+    r.lag_max_ms = static_cast<double>(lag.max_ns()) * 1e-6;
+    r.removed_volume_mm3 = geo.removed_mm3();
+  };
+  std::int64_t next_status = t0 + static_cast<std::int64_t>(opt.status_period_s * 1e9);
+  while (geo_running.load(std::memory_order_acquire)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (status && sched::now_ns() >= next_status) {
+      next_status += static_cast<std::int64_t>(opt.status_period_s * 1e9);
+      snapshot();
+      char line[320];
+      std::snprintf(line, sizeof line,
+                    "t %.1f s | rx %" PRIu64 " applied %" PRIu64 " lost %" PRIu64 " | ring hw %" PRIu64 "/%zu overruns %" PRIu64
+                    " | lag p50 %.2f p99 %.2f max %.2f ms | removed %.1f mm3 | errors %" PRIu64,
+                    static_cast<double>(sched::now_ns() - t0) * 1e-9, r.samples_received, r.samples_applied, r.samples_lost,
+                    r.ring_high_water, ring.capacity(), r.ring_overruns, r.lag_p50_ms, r.lag_p99_ms, r.lag_max_ms,
+                    r.removed_volume_mm3, src->counters().total() + sink.counters().total());
+      status(line);
+    }
+  }
+  hal_thread.join();
+  geometry.join();
+  if (recorder.joinable()) recorder.join();
+  if (rec_file != nullptr) std::fclose(rec_file);
+  src->close();
+
+  r.wall_time_s = static_cast<double>(sched::now_ns() - t0) * 1e-9;
+  geo.publish_volume();
+  snapshot();
+  r.removed_volume_mm3 = r.stock_volume_mm3 - r.solid.volume_mm3();
+  r.ring_capacity = ring.capacity();
+  r.sweeps = geo.sweeps();
+  r.batches = geo.batches();
+  r.record_overruns = sink.rec_overruns();
+  for (int k = 0; k < hal::kFaultKinds; ++k) {
+    const auto f = static_cast<hal::Fault>(k);
+    r.decode_errors[hal::fault_name(f)] = src->counters().get(f) + sink.counters().get(f);
+  }
+  const bool fifo = hal_mode.load() == 1 && geo_mode.load() == 1;
+  r.rt_mode = fifo ? "fifo" : "non-rt";
+  return r;
+}
+
+std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
+  nlohmann::json j;
+  j["source"] = r.source;
+  j["profile"] = profile.source;
+  j["samples_received"] = r.samples_received;
+  j["samples_applied"] = r.samples_applied;
+  j["samples_lost"] = r.samples_lost;
+  j["samples_rejected"] = r.samples_rejected;
+  j["ring_overruns"] = r.ring_overruns;
+  j["ring_high_water"] = r.ring_high_water;
+  j["ring_capacity"] = r.ring_capacity;
+  j["decode_errors"] = r.decode_errors;
+  j["lag_p50_ms"] = r.lag_p50_ms;
+  j["lag_p99_ms"] = r.lag_p99_ms;
+  j["lag_max_ms"] = r.lag_max_ms;
+  j["stock_volume_mm3"] = r.stock_volume_mm3;
+  j["removed_volume_mm3"] = r.removed_volume_mm3;
+  j["sweeps"] = r.sweeps;
+  j["batches"] = r.batches;
+  j["record_overruns"] = r.record_overruns;
+  j["wall_time_s"] = r.wall_time_s;
+  j["rt_mode"] = r.rt_mode;
+  j["peak_rss_mb"] = peak_rss_mb();
+  return j.dump(2) + "\n";
+}
+
+void write_live_outputs(const std::string& dir, const LiveResult& r, const Profile& profile) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": cannot create output directory: " + ec.message());
+  write_file(dir + "/metrics.json", live_metrics_json(r, profile));
+  write_file(dir + "/levels.lbrs", geom::to_bytes(r.solid));
+}
+
+nc::EmulatorLimits live_emulator_limits(const Profile& profile) {
+  nc::EmulatorLimits l = emulator_limits(profile);
+  l.sample_period_ms = profile.live.period_ms;
+  return l;
+}
+
+}  // namespace lbr::app

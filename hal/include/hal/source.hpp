@@ -1,0 +1,88 @@
+// hal/source.hpp — one interface for every live source (docs/protocols.md).
+//
+// Lifecycle: construct → open() (setup: may throw, allocates, opens devices) → poll()
+// repeatedly on the HAL thread (RT-safe: never throws, never allocates, blocks only on its
+// own device or pacing clock) → close(). Faults are counters, never exceptions.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "hal/can_codec.hpp"
+#include "hal/config.hpp"
+#include "hal/sample.hpp"
+
+namespace lbr::hal {
+
+// Raw input as received, for --record (candump -l lines, docs/protocols.md#logs).
+struct RawRecord {
+  std::int64_t t_wall_ns = 0;  // CLOCK_REALTIME receive time
+  bool serial = false;
+  CanFrame frame;              // CAN
+  std::uint16_t len = 0;       // serial: bytes used
+  std::array<std::uint8_t, 64> bytes{};
+};
+
+class SampleSink {
+ public:
+  // Called on the HAL thread with decoded (not yet validated) samples. RT-safe.
+  virtual void on_samples(std::span<const AxisSample> samples) noexcept = 0;
+  // Called with raw input when recording is enabled. RT-safe.
+  virtual void on_raw(const RawRecord& /*r*/) noexcept {}
+
+ protected:
+  ~SampleSink() = default;
+};
+
+enum class PollResult {
+  Data,   // input was processed (samples may or may not have been produced)
+  Idle,   // timeout without input
+  End,    // the source has ended (replay/emulator finished); poll no further
+  Error,  // transient failure (counted); the source retries on later polls
+};
+
+class Source {
+ public:
+  virtual ~Source() = default;
+  virtual void open() = 0;
+  // Waits at most timeout_ms for input, decodes what arrived, hands samples to `sink`.
+  virtual PollResult poll(int timeout_ms, SampleSink& sink) noexcept = 0;
+  virtual void close() noexcept = 0;
+  [[nodiscard]] virtual std::string describe() const = 0;
+  // False for sources that may wait when the ring is full (replay as fast as possible,
+  // emulator without pacing): the pipeline then applies back-pressure instead of dropping.
+  [[nodiscard]] virtual bool live() const noexcept { return true; }
+  // Samples known to be lost before the ring (sequence gaps, incomplete cycles).
+  [[nodiscard]] virtual std::uint64_t lost() const noexcept = 0;
+  [[nodiscard]] const Counters& counters() const noexcept { return counters_; }
+  void set_recording(bool on) noexcept { record_ = on; }
+
+ protected:
+  Counters counters_;
+  bool record_ = false;
+};
+
+// Generates positions for GeneratorSource (the machine emulator, app/). Called on the
+// HAL thread: must be RT-safe. Returns false at the end of the program.
+class SampleGenerator {
+ public:
+  virtual ~SampleGenerator() = default;
+  // Next position and the tool in the spindle (-1 if unknown).
+  virtual bool next(std::array<double, kMaxAxes>& q, int& tool) noexcept = 0;
+};
+
+// Factories. `speed` applies to replay (1 = real time, 0 = as fast as possible) and to the
+// generator (same meaning). Throw std::runtime_error / std::invalid_argument on bad specs.
+[[nodiscard]] std::unique_ptr<Source> make_serial_source(const std::string& device, const LiveConfig& cfg);
+[[nodiscard]] std::unique_ptr<Source> make_socketcan_source(const std::string& iface, const LiveConfig& cfg);
+[[nodiscard]] std::unique_ptr<Source> make_replay_source(const std::string& file, const LiveConfig& cfg, double speed);
+[[nodiscard]] std::unique_ptr<Source> make_generator_source(std::unique_ptr<SampleGenerator> gen, const std::string& name,
+                                                            const LiveConfig& cfg, double speed);
+
+// CLOCK_REALTIME [ns].
+[[nodiscard]] std::int64_t wall_ns() noexcept;
+
+}  // namespace lbr::hal

@@ -1,0 +1,41 @@
+#!/bin/sh
+# /init of the HIL initramfs (tools/hil/hil-bench.sh): vcan0, feeder → lbrsim run, replay
+# of the recorded log, results on the console between HIL markers, power off.
+export PATH=/bin:/sbin
+mount -t proc proc /proc
+mount -t sysfs sys /sys
+mount -t devtmpfs dev /dev 2>/dev/null
+mount -t tmpfs tmp /tmp
+for m in can can-raw can-dev vcan; do insmod /mods/$m.ko || echo "HIL-ERROR insmod $m"; done
+ip link add dev vcan0 type vcan || echo "HIL-ERROR ip link add"
+ip link set up vcan0 || echo "HIL-ERROR ip link set up"
+FAULTS="$(cat /data/faults)"
+lbrsim --log-level warn run --profile /data/profile.toml --source can:vcan0 --out /tmp/live \
+  --record /tmp/can.log --quiet > /tmp/live.txt 2>&1 &
+LBR=$!
+# Start feeding once lbrsim has bound its filtered socket (its SYNC filter shows up here).
+i=0
+while ! grep -q vcan0 /proc/net/can/rcvlist_fil 2>/dev/null && [ $i -lt 600 ]; do sleep 0.1; i=$((i+1)); done
+sleep 0.5
+# The feeder plays the drives: highest priority, so its SYNC + TPDO bursts are not split.
+lbr-feed-can --priority 90 --profile /data/profile.toml --program /data/program.moves --iface vcan0 $FAULTS > /tmp/feed.json &
+FEED=$!
+# Interface down for a while in the middle: lbrsim must count it, reconnect and go on.
+sleep 1.5
+ip link set down vcan0
+sleep 0.4
+ip link set up vcan0
+wait $FEED
+sleep 1
+kill -INT $LBR
+wait $LBR
+echo "HIL-LIVE-RC $?"
+lbrsim --log-level warn run --profile /data/profile.toml --source replay:/tmp/can.log --speed 0 --out /tmp/replay \
+  --quiet > /tmp/replay.txt 2>&1
+echo "HIL-REPLAY-RC $?"
+echo "HIL-FEED $(cat /tmp/feed.json)"
+echo "HIL-LIVE $(tr -d '\n' < /tmp/live/metrics.json)"
+echo "HIL-REPLAY $(tr -d '\n' < /tmp/replay/metrics.json)"
+cat /tmp/live.txt /tmp/replay.txt
+echo "HIL-DONE"
+poweroff -f
