@@ -52,3 +52,17 @@ execute_process(COMMAND "${LBRSIM}" profile "${OUT}/bad.toml" RESULT_VARIABLE rc
 if(rc EQUAL 0 OR NOT err MATCHES "bad.toml:3: machine.rotary: only for machine kind mill5")
   message(FATAL_ERROR "bad profile not reported as expected (rc ${rc}): ${err}")
 endif()
+
+# Live path: `lbrsim run` with the emulator source maps every sample through the same
+# kinematics (here the A30 swing of the trunnion table) and removes the same volume.
+execute_process(COMMAND "${LBRSIM}" run --quiet --source emulator:${G}/mill5-tilted.ngc --speed 0
+                        --profile ${P}/mill5-ac.toml --out "${OUT}/run-mill5"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "lbrsim run mill5 failed (${rc}): ${out} ${err}")
+endif()
+file(READ "${OUT}/run-mill5/metrics.json" metrics)
+string(JSON removed GET "${metrics}" removed_volume_mm3)
+if(removed LESS 5304 OR removed GREATER 5310)
+  message(FATAL_ERROR "lbrsim run mill5: removed volume ${removed} mm3 outside [5304, 5310]")
+endif()
