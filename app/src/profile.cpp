@@ -125,7 +125,12 @@ geom::TurningTool read_turning_tool(Section& s, const std::string& kind) {
     t.edge_length_mm = s.number("edge_length_mm", 12.0, 0.01, 1000.0, "mm");
     t.approach_deg = s.number("approach_angle_deg", t.insert == geom::InsertKind::Diamond80 ? 95.0 : 93.0, 0.0, 180.0, "deg");
   }
-  if (const std::string e = t.validate(); !e.empty()) s.fail(nullptr, "", e);
+  // validate() messages start with the key they are about; report it with its line.
+  if (const std::string e = t.validate(); !e.empty()) {
+    std::string key = e.substr(0, e.find(' '));
+    if (key == "edge_length_mm" && t.insert == geom::InsertKind::Groove) key = "depth_mm";
+    s.fail(s.raw().get(key), key, e.substr(e.find(' ') + 1));
+  }
   s.reject_unknown();
   return t;
 }
