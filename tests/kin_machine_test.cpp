@@ -171,6 +171,49 @@ live = "axial"
   EXPECT_EQ(r.solid.check_invariants(), "");
 }
 
+TEST(LatheC, HexagonByG12_1PolarInterpolation) {
+  const app::Profile p = app::parse_profile(R"(
+[machine]
+kind = "lathe-c"
+[stock]
+shape = "cylinder"
+center_mm = [0, 0]
+diameter_mm = 40
+z_min_mm = -12
+z_max_mm = 0
+[lbr]
+level_spacing_mm = 0.25
+regions = "2x2"
+[[tool]]
+number = 1
+kind = "flat"
+diameter_mm = 6
+flute_length_mm = 18
+live = "axial"
+)", "hex.toml");
+  // G7: X words are diameters of the Cartesian x; C words are the Cartesian y [mm].
+  const std::string prog =
+      "G18 G7 G90 G21\nT1 M6\nG0 X80 Z5\nG0 X41.569219 C30\nG12.1\nG1 Z-5 F300\n"
+      "G1 X36 C10.392305 F600\nG1 X0 C20.784610\nG1 X-36 C10.392305\nG1 X-36 C-10.392305\n"
+      "G1 X0 C-20.784610\nG1 X36 C-10.392305\nG0 Z5\nG13.1\nG0 X80\n";
+  const nc::Toolpath path = nc::interpret_gcode(prog, "hex.ngc", app::gcode_options(p));
+  EXPECT_GT(path.segments.size(), 300u);  // each side became ~110 polar steps
+  const app::BatchResult r = app::run_batch(p, path);
+  const double hex_area = 2.0 * std::sqrt(3.0) * 15.0 * 15.0;
+  for (int l = 0; l < r.solid.levels(); ++l) {
+    const double z = r.solid.level_z_mm(l);
+    if (z < -5.0) continue;
+    const geom::Rect b = level_rect(r.solid, l);
+    EXPECT_NEAR(geom::to_mm(b.x1) - geom::to_mm(b.x0), 30.0, 0.01) << "across flats, z " << z;
+    EXPECT_NEAR(r.solid.level_area_mm2(l), hex_area, 0.01 * 6 * 17.32);
+  }
+  // Polar interpolation belongs to lathe-c; a line through the spindle axis is refused.
+  EXPECT_THROW((void)nc::interpret_gcode("G12.1\n", "x.ngc", app::gcode_options(app::default_profile())), nc::ParseError);
+  EXPECT_THROW((void)nc::interpret_gcode("G18 G7\nT1 M6\nG0 X40 C0\nG12.1\nG1 X-40 C0 F100\n", "x.ngc",
+                                         app::gcode_options(p)),
+               nc::ParseError);
+}
+
 // ---------------------------------------------------------------- mill5
 
 TEST(Mill5, TiltedFlatEndMillPlungeLeavesTheEllipticalFootprint) {
