@@ -299,8 +299,11 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
   for (int k = 0; k < 9; ++k) put_axes(5221 + 20 * k, options.work_offsets[static_cast<std::size_t>(k)]);
   write("rs274.var", var.str());
 
-  const std::string cmd = "cd " + shell_quote(dir.string()) + " && timeout 120 " + shell_quote(exe) +
-                          " -g -i rs274.ini -t tool.tbl -v rs274.var program.ngc < /dev/null 2>&1";
+  // LinuxCNC's rs274 shares state between concurrent processes (seen here: "Bus error" when
+  // two run at once), so runs are serialised machine-wide with flock(1) on one lock file.
+  const std::string lock = (std::filesystem::temp_directory_path() / "lbrsim-rs274.lock").string();
+  const std::string cmd = "cd " + shell_quote(dir.string()) + " && flock " + shell_quote(lock) + " timeout 120 " +
+                          shell_quote(exe) + " -g -i rs274.ini -t tool.tbl -v rs274.var program.ngc < /dev/null 2>&1";
   FILE* p = ::popen(cmd.c_str(), "r");
   if (p == nullptr) throw std::runtime_error("rs274: cannot start " + exe);
   std::string out;
