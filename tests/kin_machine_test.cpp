@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "app/batch.hpp"
+#include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "kin/kinematics.hpp"
 #include "nc/gcode.hpp"
@@ -412,4 +413,50 @@ TEST(Channels, InterleavingOrderDoesNotChangeTheResult) {
   for (int l = 0; l < a.solid.levels(); ++l)
     EXPECT_NEAR(a.solid.level_area_mm2(l), c.solid.level_area_mm2(l), 2 * 2 * test::kPi * 20 * kTol)
         << a.solid.level_z_mm(l);
+}
+
+// ---------------------------------------------------------------- bundled lathe example
+
+TEST(LatheExample, ShaftProgramMatchesItsDrawingAtEveryLevel) {
+  // config/programs/lathe-shaft.ngc on config/profiles/lathe.toml, through the G-code front
+  // end and the batch runner. Drawing: face at Z-0.5; Ø24 to Z-15, Ø30 to Z-30, Ø36 to Z-45
+  // with the finishing insert's 0.4 nose fillets in the inner corners; groove Ø26 over
+  // [-27, -24] with 0.2 corners; bore Ø12 to Z-20 with a 0.4 fillet at its bottom.
+  const std::string dir = std::string(LBR_SOURCE_DIR) + "/config/";
+  const app::Profile p = app::load_profile(dir + "profiles/lathe.toml");
+  const app::BatchResult r = app::run_batch(p, app::load_toolpath(dir + "programs/lathe-shaft.ngc", p));
+  auto fillet = [](double r0, double re, double z_corner, double z) {  // inner corner at z_corner
+    const double dz = z_corner + re - z;
+    return dz > 0.0 ? r0 + re - std::sqrt(re * re - dz * dz) : r0;
+  };
+  auto outer = [&](double z) {
+    if (z <= -45.0) return 20.0;
+    if (z <= -30.0) return fillet(18.0, 0.4, -45.0, z);
+    if (z <= -27.0) return fillet(15.0, 0.4, -30.0, z);
+    if (z <= -24.0) {  // groove bottom, 0.2 corners at both walls
+      const double lo = fillet(13.0, 0.2, -27.0, z);
+      const double dz = z - (-24.0 - 0.2);
+      return dz > 0.0 ? std::max(lo, 13.2 - std::sqrt(0.04 - dz * dz)) : lo;
+    }
+    if (z <= -15.0) return 15.0;
+    return fillet(12.0, 0.4, -15.0, z);
+  };
+  auto inner = [](double z) {
+    if (z <= -20.0) return 0.0;
+    const double dz = z - (-20.0 + 0.4);
+    return dz < 0.0 ? 5.6 + std::sqrt(0.16 - dz * dz) : 6.0;
+  };
+  int checked = 0;
+  for (int l = 0; l < r.solid.levels(); ++l) {
+    const double z = r.solid.level_z_mm(l);
+    const double area = r.solid.level_area_mm2(l);
+    if (z > -0.5) {
+      EXPECT_NEAR(area, 0.0, 1e-9) << "faced off, z " << z;
+      continue;
+    }
+    const double ro = outer(z), ri = inner(z);
+    EXPECT_NEAR(area, test::kPi * (ro * ro - ri * ri), 2 * test::kPi * (ro + ri) * 0.003) << "z " << z;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 795);
 }
