@@ -94,6 +94,19 @@ struct SubtractWorkspace {
   std::vector<MoveId> sweep_id;   // their move ids
   std::vector<LatheSweep> lathe;  // one per merged turning move
   std::vector<MoveId> lathe_id;
+  // Runs of at least three consecutive horizontal moves of one tool with a vertical axis at
+  // one height: their section on a level is the polyline offset by the tool radius there,
+  // computed once per distinct radius instead of one stadium per move.
+  struct Chain {
+    const CutterShape* shape = nullptr;
+    double z = 0.0;            // tip height [mm]
+    Path pts;                  // tip positions [units]
+    MoveId id = 0;             // largest move id of the run
+    double cached_r = -1.0;    // radius of `cached` [mm]
+    Paths cached;
+  };
+  std::vector<Chain> chains;
+  std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
   Paths sections;                 // section polygons of the current level
   std::vector<Rect> section_box;  // their bounding boxes
   std::vector<MoveId> section_id; // their move ids
