@@ -216,3 +216,24 @@ TEST(Invariants, SerialisationRoundTrip) {
   bad.resize(bytes.size() - 5);
   EXPECT_THROW((void)geom::from_bytes(bad), std::runtime_error);
 }
+
+TEST(Invariants, HorizontalRunsCutLikeTheirMoves) {
+  // A horizontal polyline cut move by move (stadiums) and as one batch (one polyline offset
+  // per level radius) must agree within the chord tolerance along the cut's outline.
+  const auto sh = shapes();
+  for (int tool : {0, 1, 2}) {
+    std::vector<geom::Vec3> pts;
+    for (int i = 0; i <= 40; ++i) {
+      const double a = 0.15 * i;
+      pts.push_back({40 + 25 * std::cos(a) * (1 - 0.015 * i), 30 + 20 * std::sin(a), -4});
+    }
+    geom::LbrSolid single(test::box_spec({0, 0, -12}, {80, 60, 0}, 0.2, 4, 4));
+    test::cut_path(single, sh[tool], pts, 1);
+    geom::LbrSolid runs(test::box_spec({0, 0, -12}, {80, 60, 0}, 0.2, 4, 4));
+    test::cut_path(runs, sh[tool], pts, 64);
+    const double outline = 2 * 160.0 + 2 * test::kPi * 5;  // about twice the path length
+    EXPECT_NEAR(test::removed(runs), test::removed(single), 2 * outline * kTol * 4.0) << tool;
+    EXPECT_GT(test::removed(runs), 100.0);
+    EXPECT_EQ(runs.check_invariants(), "");
+  }
+}
