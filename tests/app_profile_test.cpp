@@ -48,11 +48,11 @@ TEST(Profile, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(error_of(kStock + "\n[[tool]]\nnumber = 1\nkind = \"drill\"\n"),
             "p.toml:6: tool.diameter_mm: missing (a number [mm] is required)");
   EXPECT_EQ(error_of(kStock + "\n[[tool]]\nnumber = 1\nkind = \"spoon\"\ndiameter_mm = 3\n"),
-            "p.toml:8: tool.kind: expected one of flat, ball, bull, drill, vbit; got 'spoon'");
+            "p.toml:8: tool.kind: expected one of flat, ball, bull, drill, vbit, turning, boring, grooving; got 'spoon'");
   EXPECT_EQ(error_of(kStock + "\n[[tool]]\nnumber = 2\nkind = \"flat\"\ndiameter_mm = 3\n[[tool]]\nnumber = 2\nkind = \"ball\"\ndiameter_mm = 3\n"),
             "p.toml:11: tool.number: tool 2 is defined twice");
   EXPECT_EQ(error_of("[stock]\nshape = \"box\"\nmin_mm = [0, 0]\n"), "p.toml:3: stock.min_mm: expected an array of 3 numbers [mm]");
-  EXPECT_EQ(error_of("[machine]\nkind = \"mill9\"\n" + kStock), "p.toml:2: machine.kind: expected \"mill3\" (other machine kinds are not supported yet), got 'mill9'");
+  EXPECT_EQ(error_of("[machine]\nkind = \"mill9\"\n" + kStock), "p.toml:2: machine.kind: expected \"mill3\", \"mill5\", \"lathe\" or \"lathe-c\", got 'mill9'");
   EXPECT_EQ(error_of("[stock\n"), "p.toml:1: Error while parsing table header: expected ']', saw '\\n'");
 }
 

@@ -18,6 +18,7 @@
 #include "geom/serialize.hpp"
 #include "hal/source.hpp"
 #include "hal/validate.hpp"
+#include "kin/kinematics.hpp"
 #include "sched/rt_thread.hpp"
 #include "sched/spsc_ring.hpp"
 
@@ -54,7 +55,7 @@ std::unique_ptr<hal::Source> make_source(const Profile& profile, const LiveOptio
   if (kind == "emulator") {
     const nc::Toolpath path = arg == "demo" ? demo_toolpath() : load_toolpath(arg, profile);
     for (const nc::Segment& sg : path.segments)
-      if (sg.tool != 0 && !profile.tools.count(sg.tool))
+      if (sg.tool != 0 && !profile.tools.count(sg.tool) && !profile.inserts.count(sg.tool))
         throw std::runtime_error(path.source + ":" + std::to_string(sg.line) + ": tool " + std::to_string(sg.tool) +
                                  " is not in the tool table of " + profile.source);
     return hal::make_generator_source(std::make_unique<EmulatorGenerator>(path, live_emulator_limits(profile)), arg,
@@ -106,20 +107,36 @@ class RingSink final : public hal::SampleSink {
   std::atomic<std::uint64_t> received_{0}, rejected_{0}, rec_overruns_{0};
 };
 
-// Geometry side: drains the ring, merges straight runs per channel, subtracts.
+// Geometry side: drains the ring, maps samples through the channel's kinematics
+// (docs/machine-kinds.md), merges straight runs per channel, subtracts.
 class Geometry {
  public:
   static constexpr std::size_t kMaxRun = 256;
 
-  // `shapes`: every tool of the profile; `default_tool` cuts for samples without a tool
-  // number. Tool numbers without a shape (0 = empty spindle) cut nothing.
-  Geometry(geom::LbrSolid& solid, const std::map<int, geom::CutterShape>& shapes, int default_tool,
-           sched::SpscRing<AxisSample>& ring, double tol_mm)
-      : solid_(solid), shapes_(shapes), ring_(ring), tol_(tol_mm) {
-    const auto it = shapes_.find(default_tool);
-    default_shape_ = it == shapes_.end() ? nullptr : &it->second;
+  // A tool as the geometry thread sees it: a milling cutter or a turning insert, its mount.
+  struct ToolRef {
+    const geom::CutterShape* shape = nullptr;
+    const geom::TurningShape* turning = nullptr;
+    kin::Mount mount = kin::Mount::Spindle;
+    double length_mm = 0.0, reach_mm = 0.0;
+    [[nodiscard]] bool cuts() const noexcept { return shape != nullptr || turning != nullptr; }
+    [[nodiscard]] bool same(const ToolRef& o) const noexcept { return shape == o.shape && turning == o.turning; }
+  };
+
+  // `shapes`/`inserts`: every tool of the profile; `default_tool` cuts for samples without a
+  // tool number. Tool numbers without a shape (0 = empty spindle) cut nothing.
+  Geometry(geom::LbrSolid& solid, const Profile& profile, const std::map<int, geom::CutterShape>& shapes,
+           const std::map<int, geom::TurningShape>& inserts, int default_tool, sched::SpscRing<AxisSample>& ring,
+           double tol_mm)
+      : solid_(solid), ring_(ring), tol_(tol_mm) {
+    for (const auto& [n, sh] : shapes)
+      tools_[n] = ToolRef{&sh, nullptr, profile.mount_of(n), sh.tool.length_mm, std::hypot(sh.height(), sh.radius())};
+    for (const auto& [n, sh] : inserts) tools_[n] = ToolRef{nullptr, &sh, kin::Mount::Turning, 0.0, 0.0};
+    default_tool_ = lookup(default_tool);
+    for (std::size_t i = 0; i < kins_.size(); ++i)
+      kins_[i] = i < profile.channels.size() ? profile.channels[i].kin : profile.kin;
     const std::size_t cap = ring.capacity();
-    batch_.reserve(cap + hal::kMaxChannels);
+    batch_.reserve(2 * cap + hal::kMaxChannels + kin::kMaxSubsteps);
     rx_.resize(cap);
     for (Channel& c : ch_) c.run.reserve(kMaxRun + 1);
   }
@@ -155,15 +172,15 @@ class Geometry {
   // Rendering: tip points go to the exchange's path buffer (no allocation).
   void set_exchange(gfx::SolidExchange* ex) noexcept { ex_ = ex; }
   // Publishes the solid to the render side between batches (never waits; see
-  // gfx/exchange.hpp). Tools: one per channel that has a position and a cutting tool.
+  // gfx/exchange.hpp). Tools: one per channel holding a milling cutter, at its latest pose.
   bool publish(const gfx::LiveStats& stats) noexcept {
     if (ex_ == nullptr) return false;
     std::array<gfx::ToolState, gfx::kMaxTools> tools{};
     std::size_t n = 0;
     for (std::size_t i = 0; i < ch_.size() && n < tools.size(); ++i) {
       const Channel& c = ch_[i];
-      if (!c.have || c.shape == nullptr) continue;
-      tools[n++] = gfx::tool_state(c.shape->tool, 1, geom::Pose{c.last, {0, 0, 1}}, static_cast<int>(i));
+      if (!c.have || c.tool.shape == nullptr || c.run.empty()) continue;
+      tools[n++] = gfx::tool_state(c.tool.shape->tool, 1, c.run.back(), static_cast<int>(i));
     }
     return ex_->publish(solid_, std::span<const gfx::ToolState>(tools.data(), n), last_id_, stats);
   }
@@ -182,11 +199,16 @@ class Geometry {
  private:
   struct Channel {
     bool have = false;
-    geom::Vec3 last{};               // latest position (end of the pending run)
-    const geom::CutterShape* shape = nullptr;  // tool of the pending run (nullptr: cuts nothing)
-    std::vector<geom::Vec3> run;     // run[0] = start of the pending sweep, then its samples
+    nc::AxisVector q{};              // latest axis values (end of the pending run)
+    ToolRef tool;                    // tool of the pending run
+    std::vector<geom::Pose> run;     // run[0] = start of the pending sweep, then its samples
     std::uint64_t seq = 0;
   };
+
+  [[nodiscard]] ToolRef lookup(int tool) const noexcept {
+    const auto it = tools_.find(tool);  // no allocation
+    return it == tools_.end() ? ToolRef{} : it->second;
+  }
 
   // Distance of p from the segment a–b [mm].
   static double dist_to_segment(geom::Vec3 p, geom::Vec3 a, geom::Vec3 b) noexcept {
@@ -196,60 +218,92 @@ class Geometry {
     return geom::norm(p - geom::lerp(a, b, t));
   }
 
+  void push(const Channel& c, const geom::Pose& from, const geom::Pose& to) noexcept {
+    if (!c.tool.cuts()) return;
+    geom::SweepRef r;
+    r.shape = c.tool.shape;
+    r.turning = c.tool.turning;
+    r.from = from;
+    r.to = to;
+    r.id = static_cast<geom::MoveId>(c.seq & 0xFFFFFFFFU);
+    last_id_ = r.id;
+    if (ex_ != nullptr) ex_->add_path_point(to.tip);
+    if (batch_.size() == batch_.capacity()) {  // capacity reserved at start-up: subtract early
+      solid_.subtract(batch_, ws_);
+      batch_.clear();
+    }
+    batch_.push_back(r);
+  }
+
   void take(const AxisSample& s) noexcept {
     if (s.channel >= hal::kMaxChannels) return;
     Channel& c = ch_[s.channel];
-    geom::Vec3 p = c.last;
-    if (s.mask & 1U) p.x = s.q[0];
-    if (s.mask & 2U) p.y = s.q[1];
-    if (s.mask & 4U) p.z = s.q[2];
+    const kin::Kinematics& k = kins_[s.channel];
+    nc::AxisVector q = c.q;
+    for (int a = 0; a < nc::kAxes && a < static_cast<int>(hal::kMaxAxes); ++a)
+      if (s.mask & (1U << a)) q[a] = s.q[static_cast<std::size_t>(a)];
     c.seq = s.seq;
-    const geom::CutterShape* shape = default_shape_;
-    if (s.tool >= 0) {
-      const auto it = shapes_.find(s.tool);  // no allocation
-      shape = it == shapes_.end() ? nullptr : &it->second;
-    }
-    if (c.have && shape != c.shape) {  // tool change: the pending run belongs to the old tool
+    const ToolRef tool = s.tool >= 0 ? lookup(s.tool) : default_tool_;
+    if (c.have && !tool.same(c.tool)) {  // tool change: the pending run belongs to the old tool
       flush(c);
-      c.shape = shape;
+      c.tool = tool;
+      c.run.clear();
+      c.run.push_back(kin::tool_pose(k, c.q, tool.mount, tool.length_mm));
     }
     if (!c.have) {  // first sample: where the tool is; nothing to cut yet
       c.have = true;
-      c.shape = shape;
-      c.last = p;
+      c.tool = tool;
+      c.q = q;
       c.run.clear();
-      c.run.push_back(p);
+      c.run.push_back(kin::tool_pose(k, q, tool.mount, tool.length_mm));
       return;
     }
-    if (p == c.last) return;  // standing still
-    if (ex_ != nullptr) ex_->add_path_point(p);
+    if (q == c.q) return;  // standing still
+    const ToolRef& t = c.tool;
+    const int n = t.cuts() ? kin::substeps(k, c.q, q, t.mount, t.length_mm, t.reach_mm, tol_) : 1;
+    if (n > 1) {
+      // Rotary axes moved the tool along a curve: chords within the tolerance.
+      flush(c);
+      geom::Pose from = c.run.back();
+      for (int i = 1; i <= n; ++i) {
+        nc::AxisVector qi = q;
+        if (i < n)
+          for (int a = 0; a < nc::kAxes; ++a) qi[a] = c.q[a] + (q[a] - c.q[a]) * i / n;
+        const geom::Pose to = kin::tool_pose(k, qi, t.mount, t.length_mm);
+        push(c, from, to);
+        from = to;
+      }
+      c.run.clear();
+      c.run.push_back(from);
+      c.q = q;
+      return;
+    }
+    const geom::Pose p = kin::tool_pose(k, q, t.mount, t.length_mm);
     if (c.run.size() >= 2) {
-      // Replace the run's straight sweep run[0]→last by run[0]→p only if every sample of
-      // the run stays within the tolerance of the longer sweep: geometry stays exact.
-      bool straight = c.run.size() < kMaxRun;
+      // Replace the run's straight sweep run[0]→last by run[0]→p only if the tool axis stays
+      // put and every sample of the run stays within the tolerance of the longer sweep:
+      // geometry stays exact.
+      bool straight = c.run.size() < kMaxRun && p.axis == c.run[0].axis && c.run.back().axis == c.run[0].axis;
       for (std::size_t i = 1; straight && i < c.run.size(); ++i)
-        straight = dist_to_segment(c.run[i], c.run[0], p) <= tol_;
+        straight = dist_to_segment(c.run[i].tip, c.run[0].tip, p.tip) <= tol_;
       if (!straight) flush(c);
     }
     c.run.push_back(p);
-    c.last = p;
+    c.q = q;
   }
 
   void flush(Channel& c) noexcept {
     if (c.run.size() < 2) return;
-    geom::Pose from{c.run.front(), {0, 0, 1}}, to{c.run.back(), {0, 0, 1}};
-    if (c.shape != nullptr) {
-      last_id_ = static_cast<geom::MoveId>(c.seq & 0xFFFFFFFFU);
-      batch_.push_back({c.shape, from, to, last_id_});
-    }
-    const geom::Vec3 end = c.run.back();
+    push(c, c.run.front(), c.run.back());
+    const geom::Pose end = c.run.back();
     c.run.clear();
     c.run.push_back(end);
   }
 
   geom::LbrSolid& solid_;
-  const std::map<int, geom::CutterShape>& shapes_;
-  const geom::CutterShape* default_shape_ = nullptr;
+  std::map<int, ToolRef> tools_;
+  ToolRef default_tool_;
+  std::array<kin::Kinematics, hal::kMaxChannels> kins_{};
   sched::SpscRing<AxisSample>& ring_;
   double tol_;
   geom::SubtractWorkspace ws_;
@@ -286,15 +340,16 @@ void write_record_line(std::FILE* f, const hal::RawRecord& r, const std::string&
 
 LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::atomic<bool>& stop, const StatusFn& status) {
   const hal::LiveConfig& cfg = profile.live;
-  const auto tool = profile.tools.find(cfg.tool);
-  if (tool == profile.tools.end())
+  if (!profile.tools.count(cfg.tool) && !profile.inserts.count(cfg.tool))
     throw std::runtime_error(profile.source + ": live.tool " + std::to_string(cfg.tool) + " is not in the tool table");
   std::map<int, geom::CutterShape> shapes;
+  std::map<int, geom::TurningShape> inserts;
   double dmax = 1.0;
   for (const auto& [n, t] : profile.tools) {
     shapes.emplace(n, geom::CutterShape::build(t, profile.solid.chord_tol_mm));
     dmax = std::max(dmax, t.diameter_mm);
   }
+  for (const auto& [n, t] : profile.inserts) inserts.emplace(n, geom::TurningShape::build(t, profile.solid.chord_tol_mm));
   geom::SolidSpec spec = profile.solid;
   if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, dmax);
   LiveResult r{geom::LbrSolid(spec), opt.source, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, {}, 0, 0, 0, 0, 0, 0, ""};
@@ -317,7 +372,7 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
   if (opt.source.rfind("can:", 0) == 0) rec_iface = opt.source.substr(4);
 
   RingSink sink(ring, rec_ring.get(), cfg, backpressure, stop);
-  Geometry geo(r.solid, shapes, cfg.tool, ring, cfg.merge_tolerance_mm);
+  Geometry geo(r.solid, profile, shapes, inserts, cfg.tool, ring, cfg.merge_tolerance_mm);
   geo.set_exchange(opt.exchange);
   if (opt.on_start) opt.on_start(r.solid);
   r.solid.clear_dirty();  // the render side starts from this state

@@ -2,10 +2,11 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
+#include <filesystem>
 #include <future>
 #include <optional>
 #include <thread>
-#include <cstdio>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -51,6 +52,7 @@ struct ViewCliOptions {
   std::size_t frames = 0;
 };
 
+
 struct EmulateOptions {
   std::string program, profile, period, out = "samples.csv", interpreter = "builtin";
 };
@@ -87,6 +89,71 @@ int run_emulate_command(const EmulateOptions& o) {
   std::printf("%llu samples every %.4g ms | machining %.3f s | %zu segments | wrote %s\n",
               static_cast<unsigned long long>(n), profile.sample_period_ms, em.total_time_s(), path.segments.size(),
               o.out.c_str());
+  return 0;
+}
+
+// `--png`: checks the rendering options and the display before the (possibly long) run.
+gfx::CaptureOptions capture_options(const BatchOptions& o) {
+  gfx::CaptureOptions cap;
+  if (o.png.empty()) return cap;
+  cap.view = gfx::parse_view(o.view);
+  cap.ortho = cap.view == gfx::StandardView::Top;
+  cap.color = gfx::parse_color_mode(o.color);
+  gfx::parse_size(o.size, cap.width, cap.height);
+  if (!gfx::display_available())
+    throw gfx::DisplayError("--png needs an X or Wayland display for its hidden OpenGL window, and neither "
+                            "DISPLAY nor WAYLAND_DISPLAY is set. Run it under a virtual X server: "
+                            "`xvfb-run -a lbrsim batch ... --png " + o.png + "`");
+  return cap;
+}
+
+void write_png_if_asked(const geom::LbrSolid& solid, const BatchOptions& o, const gfx::CaptureOptions& cap,
+                        const std::vector<gfx::ToolState>& tools) {
+  if (o.png.empty()) return;
+  gfx::capture_png(solid, o.png, cap, tools);
+  std::printf("wrote %s (%dx%d, view %s, colour %s)\n", o.png.c_str(), cap.width, cap.height, o.view.c_str(),
+              o.color.c_str());
+}
+
+void print_result(const app::BatchResult& r, const BatchOptions& o) {
+  std::printf("removed %.3f mm3 of %.3f mm3 | machining %.2f s | simulated in %.3f s (factor %.5f) | "
+              "%d levels x %d regions (%dx%d), %zu vertices\n",
+              r.removed_volume_mm3, r.stock_volume_mm3, r.machining_time_s, r.wall_time_s,
+              r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0, r.solid.levels(), r.solid.regions(),
+              r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
+  std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
+  app::write_mesh_files(r.solid, o.stl, o.ply);
+  if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
+  if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
+}
+
+// A profile with [[channel]] tables: every channel runs its own program; the sweeps are
+// merged by time (docs/machine-kinds.md#several-channels).
+int run_channels_command(const BatchOptions& o, const app::Profile& profile, const gfx::CaptureOptions& cap) {
+  if (!o.program.empty())
+    throw std::runtime_error("--program: profile " + profile.source +
+                             " defines [[channel]] tables; their programs come from channel.program");
+  const std::string dir = std::filesystem::path(profile.source).parent_path().string();
+  std::vector<app::ChannelPath> channels;
+  std::string names;
+  for (const app::Channel& c : profile.channels) {
+    if (c.program.empty()) throw std::runtime_error(profile.source + ": channel '" + c.name + "' has no program");
+    const std::filesystem::path prog = std::filesystem::path(c.program).is_absolute()
+                                           ? std::filesystem::path(c.program)
+                                           : std::filesystem::path(dir) / c.program;
+    app::Profile per = profile;
+    per.g54_origin_mm = c.g54_origin_mm;
+    channels.push_back({c.name, app::load_toolpath(prog.string(), per, interpreter_of(o.interpreter)), c.kin});
+    spdlog::info("channel {}: program {} ({} segments)", c.name, prog.string(), channels.back().path.segments.size());
+    names += (names.empty() ? "" : "+") + c.name;
+  }
+  app::Progress progress;
+  if (!o.quiet) progress = [](double f) { spdlog::info("progress {:5.1f} %", 100.0 * f); };
+  const app::BatchResult r = app::run_batch_channels(profile, channels, o.sampled, progress);
+  app::write_batch_outputs(o.out, r, profile, names);
+  std::printf("%zu channels (%s)%s\n", channels.size(), names.c_str(), o.sampled ? ", sampled" : "");
+  print_result(r, o);
+  write_png_if_asked(r.solid, o, cap, {});
   return 0;
 }
 
@@ -132,19 +199,8 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
 
 int run_batch_command(const BatchOptions& o) {
   const app::Profile profile = batch_profile(o);
-  gfx::CaptureOptions cap;
-  if (!o.png.empty()) {
-    // Check the rendering options and the display before the (possibly long) run.
-    cap.view = gfx::parse_view(o.view);
-    cap.ortho = cap.view == gfx::StandardView::Top;
-    cap.color = gfx::parse_color_mode(o.color);
-    gfx::parse_size(o.size, cap.width, cap.height);
-    if (!gfx::display_available())
-      throw gfx::DisplayError("--png needs an X or Wayland display for its hidden OpenGL window, and neither "
-                              "DISPLAY nor WAYLAND_DISPLAY is set. Run it under a virtual X server: "
-                              "`xvfb-run -a lbrsim batch ... --png " + o.png + "`");
-  }
-
+  const gfx::CaptureOptions cap = capture_options(o);
+  if (!profile.channels.empty()) return run_channels_command(o, profile, cap);
   nc::Toolpath path =
       o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   const std::string program = o.program.empty() ? path.source : o.program;
@@ -168,20 +224,8 @@ int run_batch_command(const BatchOptions& o) {
   app::BatchResult r = app::run_batch(profile, path, progress);
   if (emulated) r.machining_time_s = emulated_time_s;
   app::write_batch_outputs(o.out, r, profile, program);
-  std::printf("removed %.3f mm3 of %.3f mm3 | machining %.2f s | simulated in %.3f s (factor %.5f) | "
-              "%d levels x %d regions (%dx%d), %zu vertices\n",
-              r.removed_volume_mm3, r.stock_volume_mm3, r.machining_time_s, r.wall_time_s,
-              r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0, r.solid.levels(), r.solid.regions(),
-              r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
-  std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
-  app::write_mesh_files(r.solid, o.stl, o.ply);
-  if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
-  if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
-  if (!o.png.empty()) {
-    gfx::capture_png(r.solid, o.png, cap, app::final_tools(profile, path));
-    std::printf("wrote %s (%dx%d, view %s, colour %s)\n", o.png.c_str(), cap.width, cap.height, o.view.c_str(),
-                o.color.c_str());
-  }
+  print_result(r, o);
+  write_png_if_asked(r.solid, o, cap, app::final_tools(profile, path));
   if (o.view_window) return run_view_command(o, ViewCliOptions{});
   return 0;
 }
@@ -197,6 +241,7 @@ struct RunOptions {
   std::string view = "iso", color = "heat", size = "1280x800";
   double rate_hz = 0.0;  // 0: the profile's [render] rate_hz
 };
+
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
@@ -402,6 +447,7 @@ int main(int argc, char** argv) {
   run->add_option("--size", ro.size, "Window / screenshot size WxH [px]")->capture_default_str();
   run->add_option("--render-rate", ro.rate_hz, "Render rate [Hz] (default: the profile's [render] rate_hz, 30)")
       ->check(CLI::Range(1.0, 240.0));
+
 
   EmulateOptions em;
   CLI::App* emu = cli.add_subcommand("emulate", "Run a part program through the machine emulator and write its samples");

@@ -106,13 +106,49 @@ class Section {
   std::set<std::string> used_;
 };
 
-geom::Tool read_tool(Section& s, int& number) {
+bool is_turning_kind(const std::string& k) { return k == "turning" || k == "boring" || k == "grooving"; }
+
+// [[tool]] with kind turning, boring or grooving: a lathe insert (docs/profiles.md).
+geom::TurningTool read_turning_tool(Section& s, const std::string& kind) {
+  geom::TurningTool t;
+  t.internal = kind == "boring";
+  if (kind == "grooving") {
+    t.insert = geom::InsertKind::Groove;
+    t.width_mm = s.required_number("width_mm", 0.01, 100.0, "mm");
+    t.nose_radius_mm = s.number("nose_radius_mm", 0.0, 0.0, 10.0, "mm");
+    t.edge_length_mm = s.number("depth_mm", 10.0, 0.01, 1000.0, "mm");
+  } else {
+    const std::string ins = s.string("insert", "diamond80");
+    if (!geom::parse_insert_kind(ins, t.insert) || t.insert == geom::InsertKind::Groove)
+      s.fail(s.raw().get("insert"), "insert", "expected one of diamond80, diamond55, v35; got '" + ins + "'");
+    t.nose_radius_mm = s.number("nose_radius_mm", 0.4, 0.0, 10.0, "mm");
+    t.edge_length_mm = s.number("edge_length_mm", 12.0, 0.01, 1000.0, "mm");
+    t.approach_deg = s.number("approach_angle_deg", t.insert == geom::InsertKind::Diamond80 ? 95.0 : 93.0, 0.0, 180.0, "deg");
+  }
+  // validate() messages start with the key they are about; report it with its line.
+  if (const std::string e = t.validate(); !e.empty()) {
+    std::string key = e.substr(0, e.find(' '));
+    if (key == "edge_length_mm" && t.insert == geom::InsertKind::Groove) key = "depth_mm";
+    s.fail(s.raw().get(key), key, e.substr(e.find(' ') + 1));
+  }
+  s.reject_unknown();
+  return t;
+}
+
+geom::Tool read_tool(Section& s, int& number, kin::Mount& mount) {
   number = static_cast<int>(s.integer("number", -1, 1, 9999));
   if (number < 0) s.fail(nullptr, "number", "missing (every [[tool]] needs a number in [1, 9999])");
   geom::Tool t;
   const std::string kind = s.string("kind", "");
   const toml::node* kn = s.raw().get("kind");
-  if (!geom::parse_tool_kind(kind, t.kind)) s.fail(kn, "kind", "expected one of flat, ball, bull, drill, vbit; got '" + kind + "'");
+  if (!geom::parse_tool_kind(kind, t.kind))
+    s.fail(kn, "kind", "expected one of flat, ball, bull, drill, vbit, turning, boring, grooving; got '" + kind + "'");
+  mount = kin::Mount::Spindle;
+  if (const toml::node* ln = s.get("live")) {
+    const auto v = ln->value_exact<std::string>();
+    if (!v || (*v != "axial" && *v != "radial")) s.fail(ln, "live", "expected \"axial\" or \"radial\"");
+    mount = *v == "axial" ? kin::Mount::Axial : kin::Mount::Radial;
+  }
   t.diameter_mm = s.required_number("diameter_mm", 0.001, 1000.0, "mm");
   t.flute_length_mm = s.number("flute_length_mm", 3.0 * t.diameter_mm, 0.001, 5000.0, "mm");
   t.length_mm = s.number("length_mm", std::max(t.flute_length_mm, 6.0 * t.diameter_mm), 0.001, 5000.0, "mm");
@@ -270,8 +306,34 @@ Profile parse_profile(const std::string& text, const std::string& name) {
     Section s(*m, "machine", name);
     p.name = s.string("name", "");
     p.machine_kind = s.string("kind", "mill3");
-    if (p.machine_kind != "mill3")
-      s.fail(m->get("kind"), "kind", "expected \"mill3\" (other machine kinds are not supported yet), got '" + p.machine_kind + "'");
+    if (!kin::parse_machine_kind(p.machine_kind.c_str(), p.kin.kind))
+      s.fail(m->get("kind"), "kind", "expected \"mill3\", \"mill5\", \"lathe\" or \"lathe-c\", got '" + p.machine_kind + "'");
+    const bool mill5 = p.kin.kind == kin::MachineKind::Mill5;
+    const bool lathe = p.kin.kind == kin::MachineKind::Lathe || p.kin.kind == kin::MachineKind::LatheC;
+    auto only = [&](const char* key, bool allowed, const char* kinds) {
+      if (m->get(key) != nullptr && !allowed) s.fail(m->get(key), key, std::string("only for machine kind ") + kinds);
+    };
+    only("rotary", mill5, "mill5");
+    only("rotary_center_mm", mill5, "mill5");
+    only("pivot_length_mm", mill5, "mill5");
+    only("tcp", mill5, "mill5");
+    only("diameter_programming", lathe, "lathe or lathe-c");
+    only("turret_angle_deg", lathe, "lathe or lathe-c");
+    if (mill5) {
+      const std::string rot = s.string("rotary", "table-ac");
+      if (!kin::parse_rotary(rot.c_str(), p.kin.rotary))
+        s.fail(m->get("rotary"), "rotary", "expected \"table-ac\", \"table-bc\", \"head-ac\" or \"head-bc\", got '" + rot + "'");
+      if (m->get("rotary_center_mm") != nullptr) {
+        const auto c = s.numbers("rotary_center_mm", 3, "mm");
+        p.kin.rotary_center_mm = {c[0], c[1], c[2]};
+      }
+      p.kin.pivot_length_mm = s.number("pivot_length_mm", 0.0, 0.0, 1e4, "mm");
+      p.kin.tcp = s.boolean("tcp", false);
+    }
+    if (lathe) {
+      p.diameter_programming = s.boolean("diameter_programming", true);
+      p.kin.turret_angle_deg = s.number("turret_angle_deg", 0.0, -360.0, 360.0, "deg");
+    }
     p.rapid_mm_per_min = s.number("rapid_mm_per_min", 15000.0, 1.0, 1e6, "mm/min");
     p.tool_change_s = s.number("tool_change_s", 0.0, 0.0, 3600.0, "s");
     auto triple = [&](const char* key, std::array<double, 3>& out, double lo, double hi, const char* unit) {
@@ -350,10 +412,66 @@ Profile parse_profile(const std::string& text, const std::string& name) {
     for (const toml::node& e : *arr) {
       if (!e.is_table()) top.fail(&e, "tool", "expected [[tool]] tables");
       Section s(*e.as_table(), "tool", name);
+      const toml::node* kn = e.as_table()->get("kind");
+      const std::string kind = kn != nullptr && kn->is_string() ? *kn->value<std::string>() : "";
+      const bool lathe = p.kin.kind == kin::MachineKind::Lathe || p.kin.kind == kin::MachineKind::LatheC;
       int number = 0;
-      geom::Tool t = read_tool(s, number);
-      if (p.tools.count(number)) s.fail(e.as_table()->get("number"), "number", "tool " + std::to_string(number) + " is defined twice");
+      if (is_turning_kind(kind)) {
+        number = static_cast<int>(s.integer("number", -1, 1, 9999));
+        if (number < 0) s.fail(nullptr, "number", "missing (every [[tool]] needs a number in [1, 9999])");
+        s.string("kind", "");
+        if (!lathe) s.fail(kn, "kind", "'" + kind + "' tools need machine kind lathe or lathe-c, this is " + p.machine_kind);
+        geom::TurningTool t = read_turning_tool(s, kind);
+        if (p.tools.count(number) || p.inserts.count(number))
+          s.fail(e.as_table()->get("number"), "number", "tool " + std::to_string(number) + " is defined twice");
+        p.inserts[number] = t;
+        continue;
+      }
+      kin::Mount mount = kin::Mount::Spindle;
+      geom::Tool t = read_tool(s, number, mount);
+      if (p.tools.count(number) || p.inserts.count(number))
+        s.fail(e.as_table()->get("number"), "number", "tool " + std::to_string(number) + " is defined twice");
+      if (p.kin.kind == kin::MachineKind::Lathe)
+        s.fail(kn, "kind", "a lathe has no live tools (use machine kind lathe-c), got a '" + kind + "' tool");
+      if (p.kin.kind == kin::MachineKind::LatheC && mount == kin::Mount::Spindle) mount = kin::Mount::Axial;
+      if (p.kin.kind != kin::MachineKind::LatheC && mount != kin::Mount::Spindle)
+        s.fail(e.as_table()->get("live"), "live", "only for machine kind lathe-c");
       p.tools[number] = t;
+      p.live_mounts[number] = mount;
+    }
+  }
+
+  // Lathe kinds: the workpiece frame's Z is the spindle axis, so the stock is a bar on it.
+  if (p.kin.kind == kin::MachineKind::Lathe || p.kin.kind == kin::MachineKind::LatheC) {
+    const geom::CylinderStock& cy = p.solid.cylinder;
+    if (p.solid.shape != geom::SolidSpec::Shape::Cylinder || cy.center_x_mm != 0.0 || cy.center_y_mm != 0.0)
+      top.fail(st, "stock", "machine kind " + p.machine_kind +
+                                " needs a cylinder stock on the spindle axis (shape = \"cylinder\", center_mm = [0, 0])");
+  }
+
+  if (const toml::node* cn = top.get("channel")) {
+    const toml::array* arr = cn->as_array();
+    if (arr == nullptr) top.fail(cn, "channel", "expected an array of tables [[channel]]");
+    for (const toml::node& e : *arr) {
+      if (!e.is_table()) top.fail(&e, "channel", "expected [[channel]] tables");
+      Section s(*e.as_table(), "channel", name);
+      Channel c;
+      c.kin = p.kin;
+      c.g54_origin_mm = p.g54_origin_mm;
+      c.name = s.string("name", "ch" + std::to_string(p.channels.size() + 1));
+      c.program = s.string("program", "");
+      if (e.as_table()->get("g54_origin_mm") != nullptr) {
+        const auto v = s.numbers("g54_origin_mm", 3, "mm");
+        c.g54_origin_mm = {v[0], v[1], v[2]};
+      }
+      const bool lathe = p.kin.kind == kin::MachineKind::Lathe || p.kin.kind == kin::MachineKind::LatheC;
+      if (e.as_table()->get("turret_angle_deg") != nullptr && !lathe)
+        s.fail(e.as_table()->get("turret_angle_deg"), "turret_angle_deg", "only for machine kind lathe or lathe-c");
+      c.kin.turret_angle_deg = s.number("turret_angle_deg", p.kin.turret_angle_deg, -360.0, 360.0, "deg");
+      for (const Channel& o : p.channels)
+        if (o.name == c.name) s.fail(e.as_table()->get("name"), "name", "channel '" + c.name + "' is defined twice");
+      s.reject_unknown();
+      p.channels.push_back(std::move(c));
     }
   }
   read_live(top, p, name);
@@ -378,11 +496,32 @@ const char* default_profile_text() noexcept { return kDefaultProfileToml; }
 
 Profile default_profile() { return parse_profile(kDefaultProfileToml, "<built-in default-mill3>"); }
 
+kin::Mount Profile::mount_of(int tool) const {
+  if (inserts.count(tool)) return kin::Mount::Turning;
+  const auto it = live_mounts.find(tool);
+  return it != live_mounts.end() ? it->second : kin::Mount::Spindle;
+}
+
+nc::GcodeOptions gcode_options(const Profile& p, const Channel& c) {
+  nc::GcodeOptions o = gcode_options(p);
+  for (int a = 0; a < 3; ++a) o.work_offsets[0][a] = c.g54_origin_mm[static_cast<std::size_t>(a)];
+  return o;
+}
+
 nc::GcodeOptions gcode_options(const Profile& p) {
   nc::GcodeOptions o;
-  o.machine = nc::MachineKind::Mill3;  // the only kind profiles accept so far
+  switch (p.kin.kind) {
+    case kin::MachineKind::Mill3: o.machine = nc::MachineKind::Mill3; break;
+    case kin::MachineKind::Mill5: o.machine = nc::MachineKind::MillRotary; break;
+    case kin::MachineKind::Lathe: o.machine = nc::MachineKind::Lathe; break;
+    case kin::MachineKind::LatheC: o.machine = nc::MachineKind::LatheC; break;
+  }
+  const bool lathe = p.kin.kind == kin::MachineKind::Lathe || p.kin.kind == kin::MachineKind::LatheC;
+  o.diameter_mode = lathe && p.diameter_programming;
+  // On lathes the programmed point is the tool's reference point (the controller applies the
+  // X/Z offsets it measured), so no tool length is applied (docs/machine-kinds.md).
   for (const auto& [n, t] : p.tools) {
-    o.tool_lengths[n] = t.length_mm;
+    o.tool_lengths[n] = lathe ? 0.0 : t.length_mm;
     o.tool_diameters[n] = t.diameter_mm;
   }
   o.chord_tol_mm = p.solid.chord_tol_mm;

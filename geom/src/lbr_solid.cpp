@@ -251,18 +251,18 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
   std::size_t i = 0;
   while (i < batch.size()) {
     const SweepRef& first = batch[i];
-    if (first.shape == nullptr) {
+    if (first.shape == nullptr && first.turning == nullptr) {
       ++i;
       continue;
     }
     SweepRef merged = first;
-    const double tol = 0.5 * first.shape->chord_tol_mm;
+    const double tol = 0.5 * (first.shape != nullptr ? first.shape->chord_tol_mm : first.turning->chord_tol_mm);
     std::size_t j = i + 1;
     // Extend the run while the next move continues this one with the same tool and a fixed
     // axis, and every intermediate point stays within tol/2 of the merged chord.
     while (j < batch.size() && j - i < kMaxRun) {
       const SweepRef& n = batch[j];
-      if (n.shape != first.shape || !(n.from.tip == merged.to.tip) || !same_axis(n.from.axis, first.from.axis) ||
+      if (n.shape != first.shape || n.turning != first.turning || !(n.from.tip == merged.to.tip) || !same_axis(n.from.axis, first.from.axis) ||
           !same_axis(n.to.axis, first.from.axis) || !same_axis(first.to.axis, first.from.axis))
         break;
       bool ok = true;
@@ -282,13 +282,54 @@ SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int lev
   SubtractStats stats;
   merge_collinear(batch, ws.merged);
   ws.sweeps.clear();
+  ws.sweep_id.clear();
+  ws.lathe.clear();
+  ws.lathe_id.clear();
+  ws.chain_count = 0;
   double zlo = INFINITY, zhi = -INFINITY;
-  for (const SweepRef& s : ws.merged) {
+  auto horizontal = [](const SweepRef& r) {
+    return r.turning == nullptr && r.shape != nullptr && r.from.tip.z == r.to.tip.z && r.from.axis.x == 0.0 &&
+           r.from.axis.y == 0.0 && r.from.axis.z > 0.0 && r.to.axis.x == 0.0 && r.to.axis.y == 0.0 && r.to.axis.z > 0.0;
+  };
+  for (std::size_t i = 0; i < ws.merged.size(); ++i) {
+    const SweepRef& s = ws.merged[i];
+    if (horizontal(s)) {
+      std::size_t j = i + 1;
+      while (j < ws.merged.size() && horizontal(ws.merged[j]) && ws.merged[j].shape == s.shape &&
+             ws.merged[j].from.tip.z == s.from.tip.z && ws.merged[j].from.tip == ws.merged[j - 1].to.tip)
+        ++j;
+      if (j - i >= 3) {
+        if (ws.chains.size() <= ws.chain_count) ws.chains.emplace_back();
+        SubtractWorkspace::Chain& c = ws.chains[ws.chain_count++];
+        c.shape = s.shape;
+        c.z = s.from.tip.z;
+        c.pts.clear();
+        c.pts.push_back({to_units(s.from.tip.x), to_units(s.from.tip.y)});
+        c.id = 0;
+        for (std::size_t k = i; k < j; ++k) {
+          c.pts.push_back({to_units(ws.merged[k].to.tip.x), to_units(ws.merged[k].to.tip.y)});
+          c.id = std::max(c.id, ws.merged[k].id);
+        }
+        c.cached_r = -1.0;
+        zlo = std::min(zlo, c.z);
+        zhi = std::max(zhi, c.z + s.shape->height());
+        i = j - 1;
+        continue;
+      }
+    }
+    if (s.turning != nullptr) {
+      ws.lathe.emplace_back(*s.turning, s.from.tip.x, s.from.tip.z, s.to.tip.x, s.to.tip.z);
+      ws.lathe_id.push_back(s.id);
+      zlo = std::min(zlo, ws.lathe.back().z_min());
+      zhi = std::max(zhi, ws.lathe.back().z_max());
+      continue;
+    }
     ws.sweeps.emplace_back(*s.shape, s.from, s.to);
+    ws.sweep_id.push_back(s.id);
     zlo = std::min(zlo, ws.sweeps.back().z_min());
     zhi = std::max(zhi, ws.sweeps.back().z_max());
   }
-  if (ws.sweeps.empty() || zhi < z0_ || zlo > z1_) return stats;
+  if ((ws.sweeps.empty() && ws.lathe.empty() && ws.chain_count == 0) || zhi < z0_ || zlo > z1_) return stats;
   stride = std::max(stride, 1);
   int lb = level_begin;
   const int first = level_at(zlo);
@@ -312,8 +353,62 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
     sw.section(zc, ws.sections, ws.scratch);
     for (std::size_t k = before; k < ws.sections.size(); ++k) {
       ws.section_box.push_back(bounds_of(ws.sections[k]));
-      ws.section_id.push_back(ws.merged[si].id);
+      ws.section_id.push_back(ws.sweep_id[si]);
       all.add(ws.section_box.back());
+    }
+  }
+  for (std::size_t ci = 0; ci < ws.chain_count; ++ci) {
+    SubtractWorkspace::Chain& c = ws.chains[ci];
+    const double h = zc - c.z;
+    if (h < 0.0 || h > c.shape->height()) continue;
+    const double r = c.shape->radius_at(h);
+    if (r <= 0.0) continue;
+    if (r != c.cached_r) {
+      // Offset vertices lie on radius r + tol/4 and chords sag at most tol/2 inside it, so
+      // the boundary stays within ±tol/4 of the exact one.
+      const double tol = c.shape->chord_tol_mm;
+      ClipperLib::ClipperOffset off(2.0, 0.5 * tol * kUnitsPerMm);
+      off.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
+      c.cached.clear();
+      off.Execute(c.cached, (r + 0.25 * tol) * kUnitsPerMm);
+      c.cached_r = r;
+    }
+    for (const Path& p : c.cached) {
+      ws.sections.push_back(p);
+      ws.section_box.push_back(bounds_of(p));
+      ws.section_id.push_back(c.id);
+      all.add(ws.section_box.back());
+    }
+  }
+  // Turning moves: the union of their revolved regions on this level is one region, the
+  // smallest r_min (external) and the largest r_max (internal); it takes the latest move id
+  // among them.
+  if (!ws.lathe.empty()) {
+    double r_out = INFINITY, r_in = -INFINITY, tol = spec_.chord_tol_mm;
+    MoveId id_out = 0, id_in = 0;
+    for (std::size_t si = 0; si < ws.lathe.size(); ++si) {
+      const LatheSweep& lw = ws.lathe[si];
+      double lo = 0, hi = 0;
+      if (zc < lw.z_min() || zc > lw.z_max() || !lw.interval(zc, lo, hi)) continue;
+      tol = lw.chord_tol_mm();
+      if (lw.internal()) {
+        if (hi > r_in) r_in = hi;
+        id_in = std::max(id_in, ws.lathe_id[si]);
+      } else {
+        if (lo < r_out) r_out = lo;
+        id_out = std::max(id_out, ws.lathe_id[si]);
+      }
+    }
+    for (int internal = 0; internal < 2; ++internal) {
+      const double r = internal ? r_in : r_out;
+      if (!std::isfinite(r)) continue;
+      const std::size_t before = ws.sections.size();
+      LatheSweep::removed_region(r, internal != 0, tol, xy_, ws.sections);
+      for (std::size_t k = before; k < ws.sections.size(); ++k) {
+        ws.section_box.push_back(bounds_of(ws.sections[k]));
+        ws.section_id.push_back(internal ? id_in : id_out);
+        all.add(ws.section_box.back());
+      }
     }
   }
   stats.sections = ws.sections.size();

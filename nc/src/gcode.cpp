@@ -198,6 +198,7 @@ class Interpreter {
       case MachineKind::Mill3: return a <= Z;
       case MachineKind::MillRotary: return true;
       case MachineKind::Lathe: return a == X || a == Z;
+      case MachineKind::LatheC: return a == X || a == Y || a == Z || a == C;
     }
     return false;
   }
@@ -206,6 +207,7 @@ class Interpreter {
       case MachineKind::Mill3: return "mill3 has X Y Z";
       case MachineKind::MillRotary: return "mill-rotary has X Y Z A B C";
       case MachineKind::Lathe: return "lathe has X Z";
+      case MachineKind::LatheC: return "lathe-c has X Y Z C";
     }
     return "?";
   }
@@ -243,7 +245,7 @@ class Interpreter {
   static int code10(const Word& w) { return static_cast<int>(std::lround(w.value * 10.0)); }
 
   enum Group { kMotion, kPlane, kDistance, kArcDistance, kFeedMode, kUnits, kCutter, kLength, kRetract, kCoord,
-               kPath, kLathe, kNonModal, kGroups };
+               kPath, kLathe, kPolar, kNonModal, kGroups };
   int group_of(const Word& w) const {
     const int c = code10(w);
     if (std::abs(w.value * 10.0 - c) > 1e-6) return -1;
@@ -260,6 +262,7 @@ class Interpreter {
       case 540: case 550: case 560: case 570: case 580: case 590: case 591: case 592: case 593: return kCoord;
       case 610: case 611: case 640: return kPath;
       case 70: case 80: return kLathe;
+      case 121: case 131: return kPolar;
       case 40: case 100: case 280: case 281: case 300: case 301: case 530: return kNonModal;
       default: return -1;
     }
@@ -353,8 +356,13 @@ class Interpreter {
     }
     if (gw[kUnits]) scale_ = code10(*gw[kUnits]) == 200 ? kInch : 1.0;
     // kCutter: G40 (compensation off) is the only state the interpreter has.
+    if (gw[kPolar]) {
+      if (opt_.machine != MachineKind::LatheC)
+        fail("'" + gw[kPolar]->text + "' (polar interpolation) needs machine kind lathe-c");
+      polar_ = code10(*gw[kPolar]) == 121;
+    }
     if (gw[kLathe]) {
-      if (opt_.machine != MachineKind::Lathe)
+      if (opt_.machine != MachineKind::Lathe && opt_.machine != MachineKind::LatheC)
         fail("'" + gw[kLathe]->text + "' (lathe " + (code10(*gw[kLathe]) == 70 ? "diameter" : "radius") +
              " mode) needs machine kind lathe");
       diameter_mode_ = code10(*gw[kLathe]) == 70;
@@ -412,7 +420,10 @@ class Interpreter {
         for (char L : kAxisLetters)
           if (has(b, L)) fail("axis word '" + text(b, L) + "' given but no motion mode is in effect");
       }
-      if (motion_ == 0 || motion_ == 10) move_line(motion_, target(b, false), f_in_block);
+      if (polar_) {
+        if (motion_ != 0 && motion_ != 10) fail("only G0 and G1 are supported in polar interpolation (G12.1)");
+        move_polar(b, f_in_block);
+      } else if (motion_ == 0 || motion_ == 10) move_line(motion_, target(b, false), f_in_block);
       else if (motion_ == 20 || motion_ == 30) move_arc(b, f_in_block);
       else if (motion_ >= 0) canned_cycle(b);
     }
@@ -484,6 +495,66 @@ class Interpreter {
     } else {
       const double f = feed_for_move("G1", f_in_block);
       b_.feed(line_, t, f, inverse_time_);
+    }
+  }
+
+  // G12.1 polar interpolation (lathe-c): X (a diameter in G7) and C are Cartesian coordinates
+  // x, y [program units] of the tool centre in the face plane of the part, which turns with
+  // C; the tool sits at polar angle φ = -C in the workpiece frame (docs/machine-kinds.md).
+  // The straight Cartesian line becomes (X radius, C) steps whose linear interpolation stays
+  // within tol/2 of it: angular steps of at most 2·sqrt(tol / r_max).
+  void move_polar(Block& b, bool f_in_block) {
+    if (has(b, 'Y')) fail("word '" + text(b, 'Y') + "' cannot be used in polar interpolation (G12.1)");
+    const AxisVector p0 = b_.position();
+    constexpr double kRad = 3.14159265358979323846 / 180.0;
+    const double x0 = p0[X] * std::cos(-p0[C] * kRad), y0 = p0[X] * std::sin(-p0[C] * kRad);
+    double xt = x0, yt = y0, zt = p0[Z];
+    if (has(b, 'X')) xt = absolute_ ? axis_value(b, X) : x0 + axis_value(b, X);
+    if (has(b, 'C')) yt = absolute_ ? len(b, 'C') : y0 + len(b, 'C');
+    if (has(b, 'Z')) zt = absolute_ ? len(b, 'Z') : p0[Z] + len(b, 'Z');
+    if (inverse_time_) fail("inverse time feed (G93) is not supported in polar interpolation (G12.1)");
+    const double dx = xt - x0, dy = yt - y0, L = std::hypot(dx, dy);
+    // Linear interpolation of (r, φ) between two points of the line at distance d from the
+    // axis deviates from it by at most ds² / (8 d): steps of ds = 2·sqrt(tol / 2 · d) keep
+    // that within tol / 4.
+    double d_min = std::min(std::hypot(x0, y0), std::hypot(xt, yt));
+    if (L > 0.0) {
+      const double tc = -(x0 * dx + y0 * dy) / (L * L);
+      if (tc > 0.0 && tc < 1.0) d_min = std::abs(x0 * dy - y0 * dx) / L;
+      if (tc > 0.0 && tc < 1.0 && d_min < 1e-3) fail("polar interpolation (G12.1): the line passes through the spindle axis");
+    }
+    const double ds = 2.0 * std::sqrt(0.5 * opt_.chord_tol_mm * std::max(d_min, 1e-3));
+    const double steps_d = L > 0.0 ? std::ceil(L / ds) : 1.0;
+    if (steps_d > 1e6) fail("polar interpolation (G12.1): too many steps for this line");
+    const int n = std::max(1, static_cast<int>(steps_d));
+    const double f = motion_ == 10 ? feed_for_move("G1", f_in_block) : 0.0;
+    double c_prev = p0[C];
+    AxisVector prev = p0;
+    for (int i = 1; i <= n; ++i) {
+      const double t = static_cast<double>(i) / n;
+      const double x = x0 + t * dx, y = y0 + t * dy;
+      AxisVector q = p0;
+      q[X] = std::hypot(x, y);
+      q[Z] = p0[Z] + t * (zt - p0[Z]);
+      // C = -φ, unwrapped to the nearest turn of the previous step.
+      double c = q[X] > 1e-12 ? -std::atan2(y, x) / kRad : c_prev;
+      c += 360.0 * std::round((c_prev - c) / 360.0);
+      q[C] = c;
+      c_prev = c;
+      if (motion_ == 0) {
+        b_.rapid(line_, q);
+      } else {
+        // Cartesian feed along the line: the step's duration is its Cartesian length / F.
+        const double seg = L / n;
+        const double joint = std::hypot(q[X] - prev[X], q[Z] - prev[Z]);
+        double fj = f;
+        if (!inverse_time_ && seg > 0.0) {
+          fj = joint > 1e-9 ? f * joint / seg : f * std::abs(q[C] - prev[C]) / seg;
+          fj = std::max(fj, 1e-6);
+        }
+        b_.feed(line_, q, fj, inverse_time_);
+      }
+      prev = q;
     }
   }
 
@@ -647,7 +718,8 @@ class Interpreter {
   int wcs_ = 0;
   double scale_ = 1.0;  // mm per program length unit
   bool absolute_ = true, arc_absolute_ = false, inverse_time_ = false, retract_to_initial_ = true;
-  bool diameter_mode_ = false;
+  bool diameter_mode_ = opt_.diameter_mode;
+  bool polar_ = false;  // G12.1 in effect (lathe-c)
   Plane plane_ = Plane::XY;
   int motion_ = -1;  // code x 10; -1: none (G80 or program start)
   double feed_ = 0.0;

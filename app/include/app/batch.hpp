@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "app/profile.hpp"
 #include "geom/lbr_solid.hpp"
@@ -30,6 +31,23 @@ using Progress = std::function<void(double)>;
 // when the path uses a tool the profile does not define. Segments with tool 0 (empty
 // spindle) remove nothing.
 [[nodiscard]] BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress = {});
+
+// One channel of a multi-channel run: its tool path and kinematics.
+struct ChannelPath {
+  std::string name;
+  nc::Toolpath path;
+  kin::Kinematics kin;
+};
+
+// Runs several channels cutting the same stock (docs/machine-kinds.md#several-channels).
+// Every channel is timed by the machine emulator (emulator_limits(profile)); each segment's
+// sweep enters the kernel at the time its motion ends (sub-steps of a segment at their share
+// of it), ties in channel order. With `sampled`, the channels' emulated sample streams are
+// merged instead, by sample time, as live mode receives them. Move ids: segment index + 1
+// plus the segment counts of the channels before (sampled: running sample count).
+// machining_time_s is the longest channel's emulated time.
+[[nodiscard]] BatchResult run_batch_channels(const Profile& profile, const std::vector<ChannelPath>& channels,
+                                             bool sampled = false, const Progress& progress = {});
 
 // Machining time [s] of a tool path under the simple motion model of the batch runner
 // (feed and rapid rates, no acceleration).

@@ -5,9 +5,12 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "geom/lbr_solid.hpp"
 #include "geom/tool.hpp"
+#include "geom/turning.hpp"
+#include "kin/kinematics.hpp"
 #include "hal/config.hpp"
 #include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
@@ -17,6 +20,15 @@ namespace lbr::app {
 class ProfileError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// One channel of a multi-channel machine ([[channel]] tables, docs/profiles.md): its own
+// program, G54 origin and turret direction; tools come from the shared tool table.
+struct Channel {
+  std::string name;
+  std::string program;       // path as written, resolved against the profile's folder
+  std::array<double, 3> g54_origin_mm{0, 0, 0};
+  kin::Kinematics kin;       // the machine's kinematics with this channel's turret angle
 };
 
 struct Profile {
@@ -35,9 +47,17 @@ struct Profile {
   bool regions_auto = false;
   int batch_moves = 64;     // moves per subtract() call in batch mode
   int threads = 0;          // batch-mode kernel threads (0 = one per hardware thread)
-  std::map<int, geom::Tool> tools;
+  std::map<int, geom::Tool> tools;             // milling tools (spindle or live tools)
   double render_rate_hz = 30.0;  // [render] rate_hz: the render thread's fixed frame rate
   hal::LiveConfig live;     // [live], [[live.axis]], [threads]: `lbrsim run` (docs/profiles.md)
+  // Machine kinematics ([machine] kind, rotary, ... in docs/profiles.md).
+  kin::Kinematics kin;
+  bool diameter_programming = true;            // lathe kinds: X words are diameters (G7)
+  std::map<int, geom::TurningTool> inserts;    // turning tools (lathe kinds), same numbering
+  std::map<int, kin::Mount> live_mounts;       // lathe-c: how each milling tool is mounted
+  std::vector<Channel> channels;               // empty: one channel, the program given
+  // Mount of tool n on this machine (Spindle on mills).
+  [[nodiscard]] kin::Mount mount_of(int tool) const;
 };
 
 // Parses profile text; `name` is used in messages. Throws ProfileError("name:line: ...").
@@ -49,6 +69,8 @@ struct Profile {
 
 // Interpreter options from a profile: tool lengths, machine kind, chord tolerance, G54 origin.
 [[nodiscard]] nc::GcodeOptions gcode_options(const Profile& p);
+// The same for one channel of a multi-channel profile (its G54 origin).
+[[nodiscard]] nc::GcodeOptions gcode_options(const Profile& p, const Channel& c);
 // Emulator limits from a profile (axis limits, rapid rate, sample period, tool change time).
 [[nodiscard]] nc::EmulatorLimits emulator_limits(const Profile& p);
 

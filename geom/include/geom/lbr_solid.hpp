@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "geom/sweep.hpp"
+#include "geom/turning.hpp"
 #include "geom/types.hpp"
 
 namespace lbr::geom {
@@ -60,11 +61,16 @@ struct SolidSpec {
   bool strictly_simple = false;   // ask Clipper for strictly simple output (no touching vertices)
 };
 
-// One tool movement to remove: the shape must outlive the call.
+// One tool movement to remove: the shape must outlive the call. Either a milling tool
+// (`shape`, swept between two poses at any orientation) or a turning insert (`turning`, set
+// instead of `shape`): a rotating-part sweep whose insert reference point goes from
+// (from.tip.x, from.tip.z) to (to.tip.x, to.tip.z) in the (r, z) plane; the removed region
+// is the insert profile revolved about the workpiece Z axis (geom/turning.hpp).
 struct SweepRef {
   const CutterShape* shape = nullptr;
   Pose from, to;
   MoveId id = 0;
+  const TurningShape* turning = nullptr;
 };
 
 struct SubtractStats {
@@ -86,7 +92,23 @@ struct SubtractWorkspace {
   ClipperLib::PolyTree tree;
   SectionScratch scratch;
   std::vector<SweepRef> merged;   // the batch after merging collinear runs
-  std::vector<Sweep> sweeps;      // one per merged move
+  std::vector<Sweep> sweeps;      // one per merged milling move
+  std::vector<MoveId> sweep_id;   // their move ids
+  std::vector<LatheSweep> lathe;  // one per merged turning move
+  std::vector<MoveId> lathe_id;
+  // Runs of at least three consecutive horizontal moves of one tool with a vertical axis at
+  // one height: their section on a level is the polyline offset by the tool radius there,
+  // computed once per distinct radius instead of one stadium per move.
+  struct Chain {
+    const CutterShape* shape = nullptr;
+    double z = 0.0;            // tip height [mm]
+    Path pts;                  // tip positions [units]
+    MoveId id = 0;             // largest move id of the run
+    double cached_r = -1.0;    // radius of `cached` [mm]
+    Paths cached;
+  };
+  std::vector<Chain> chains;
+  std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
   Paths sections;                 // section polygons of the current level
   std::vector<Rect> section_box;  // their bounding boxes
   std::vector<MoveId> section_id; // their move ids

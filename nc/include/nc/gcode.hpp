@@ -27,6 +27,7 @@ enum class MachineKind : unsigned char {
   Mill3,       // X Y Z
   MillRotary,  // X Y Z A B C (rotary axes [deg] carried into Segment::end[A..C])
   Lathe,       // X Z; G7 diameter mode / G8 radius mode apply to X words
+  LatheC,      // X Y Z C (C spindle positioning [deg], live tools); G7 / G8 as Lathe
 };
 
 struct GcodeOptions {
@@ -43,6 +44,7 @@ struct GcodeOptions {
   AxisVector g30_home{};       // machine coordinates of the G30 position [mm, deg]
   AxisVector start_machine{};  // gauge line at program start, machine coordinates (homed: 0)
   int start_tool = 0;          // tool in the spindle at program start (0 = none)
+  bool diameter_mode = false;  // lathe kinds: G7 (X words are diameters) at program start
 };
 
 // Interprets G-code text. `name` is used in messages and as Toolpath::source. Arcs become
