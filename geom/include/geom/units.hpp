@@ -21,7 +21,9 @@ inline constexpr double kSafeRangeMm = static_cast<double>(kSafeRange) * kMmPerU
 // Round a length in mm to kernel units. Real-time safe, no allocation.
 // Callers guarantee |mm| <= kSafeRangeMm (LbrSolid and Sweep check their inputs).
 [[nodiscard]] inline Coord to_units(double mm) noexcept {
-  return static_cast<Coord>(std::llround(mm * kUnitsPerMm));
+  // Round half away from zero, like llround, without the libm call (hot in section code).
+  const double u = mm * kUnitsPerMm;
+  return static_cast<Coord>(u + (u >= 0.0 ? 0.5 : -0.5));
 }
 [[nodiscard]] inline double to_mm(Coord units) noexcept {
   return static_cast<double>(units) * kMmPerUnit;
