@@ -231,7 +231,7 @@ int run_batch_command(const BatchOptions& o) {
 }
 
 struct RunOptions {
-  std::string profile, out = "lbrsim-out";
+  std::string profile, out = "lbrsim-out", stl, ply;
   app::LiveOptions live;
   bool quiet = false;
   // rendering (gfx/): a viewer window when a display exists, screenshots on request
@@ -331,6 +331,7 @@ int run_live_command(const RunOptions& o) {
   }
   const app::LiveResult& r = *result;
   app::write_live_outputs(o.out, r, profile);
+  app::write_mesh_files(r.solid, o.stl, o.ply);
   std::uint64_t errors = 0;
   for (const auto& [k, v] : r.decode_errors) errors += v;
   std::printf("%s | received %llu applied %llu lost %llu | ring overruns %llu high water %llu | decode errors %llu | "
@@ -340,7 +341,8 @@ int run_live_command(const RunOptions& o) {
               static_cast<unsigned long long>(r.ring_overruns), static_cast<unsigned long long>(r.ring_high_water),
               static_cast<unsigned long long>(errors), r.lag_p50_ms, r.lag_p99_ms, r.lag_max_ms, r.removed_volume_mm3,
               r.rt_mode.c_str(), g_stop.load() ? " | stopped by signal" : "");
-  std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
+  std::printf("wrote %s/metrics.json and %s/levels.lbrs%s%s%s%s\n", o.out.c_str(), o.out.c_str(),
+              o.stl.empty() ? "" : ", ", o.stl.c_str(), o.ply.empty() ? "" : ", ", o.ply.c_str());
   return 0;
 }
 
@@ -422,9 +424,12 @@ int main(int argc, char** argv) {
 
   RunOptions ro;
   CLI::App* run = cli.add_subcommand("run", "Simulate live from a machine (CAN, serial), a log replay or the emulator");
+  ro.live.source = "emulator:demo";
   run->add_option("--source", ro.live.source,
                   "can:IFACE | serial:DEVICE | replay:LOGFILE | emulator:PROGRAM (PROGRAM 'demo' = bundled demo)")
-      ->required();
+      ->capture_default_str();
+  run->add_option("--stl", ro.stl, "Also write the final part as binary STL");
+  run->add_option("--ply", ro.ply, "Also write the final part as binary PLY (with move ids)");
   run->add_option("--profile", ro.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
   run->add_option("--speed", ro.live.speed, "Replay/emulator pacing: 1 = real time, 0 = as fast as possible")
       ->check(CLI::Range(0.0, 1000.0))
