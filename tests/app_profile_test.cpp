@@ -82,8 +82,8 @@ TEST(Profile, CommandLineOverrides) {
 TEST(Profile, AutoRegionGrid) {
   geom::SolidSpec s;
   s.box = {{0, 0, 0}, {100, 80, 10}};
-  EXPECT_EQ(app::auto_region_grid(s, 10.0), std::make_pair(3, 3));
-  EXPECT_EQ(app::auto_region_grid(s, 2.0), std::make_pair(16, 13));
+  EXPECT_EQ(app::auto_region_grid(s, 10.0), std::make_pair(4, 3));
+  EXPECT_EQ(app::auto_region_grid(s, 2.0), std::make_pair(16, 16));
 }
 
 TEST(Batch, RunsAMoveListAndReportsMachiningTime) {

@@ -18,10 +18,12 @@
 #include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
+#include "app/tune.hpp"
 #include "app/view.hpp"
 #include "gfx/viewer.hpp"
 #include "gfx/window.hpp"
 #include "nc/emulator.hpp"
+#include "nc/gcode.hpp"
 
 #ifndef LBRSIM_VERSION
 #define LBRSIM_VERSION "dev"
@@ -464,6 +466,17 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
 
+  struct TuneOptions {
+    std::string program, profile, write;
+    int repeats = 1;
+  } to;
+  CLI::App* tune = cli.add_subcommand(
+      "tune", "Measure the kernel on a program's sampled stream for several region grids and pick the fastest");
+  tune->add_option("--program", to.program, "Part program (.ngc, .nc, .gcode, .tap or .moves)")->required();
+  tune->add_option("--profile", to.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
+  tune->add_option("--write", to.write, "Write the profile with the fastest grid as lbr.regions to this file");
+  tune->add_option("--repeats", to.repeats, "Runs per grid (the best counts)")->check(CLI::Range(1, 20))->capture_default_str();
+
   std::string check_path;
   bool print_default = false;
   CLI::App* prof = cli.add_subcommand("profile", "Check a profile, or print the built-in default profile");
@@ -479,6 +492,29 @@ int main(int argc, char** argv) {
     if (view->parsed()) return run_view_command(vb, vv);
     if (run->parsed()) return run_live_command(ro);
     if (emu->parsed()) return run_emulate_command(em);
+    if (tune->parsed()) {
+      const app::Profile profile = to.profile.empty() ? app::default_profile() : app::load_profile(to.profile);
+      const nc::Toolpath sampled =
+          nc::sampled_toolpath(app::load_toolpath(to.program, profile), app::emulator_limits(profile));
+      const double machining = nc::emulated_time_s(app::load_toolpath(to.program, profile), app::emulator_limits(profile));
+      double dmax = 1.0;
+      for (const auto& [n, t] : profile.tools) dmax = std::max(dmax, t.diameter_mm);
+      const auto grids = app::tune_candidates(profile, dmax);
+      std::printf("tune: %s, %zu samples, %zu grids, one kernel thread\n", to.program.c_str(), sampled.segments.size(),
+                  grids.size());
+      const auto t = app::tune_regions(profile, sampled, grids, to.repeats, [&](const app::GridTiming& g) {
+        std::printf("  %2dx%-2d  %8.3f s  factor %.5f\n", g.nx, g.ny, g.wall_s, machining > 0 ? g.wall_s / machining : 0.0);
+        std::fflush(stdout);
+      });
+      std::printf("fastest: regions = \"%dx%d\" (%.3f s)\n", t.front().nx, t.front().ny, t.front().wall_s);
+      if (!to.write.empty()) {
+        const std::string base = to.profile.empty() ? std::string(app::default_profile_text())
+                                                    : nc::read_text_file(to.profile);
+        app::write_file(to.write, app::set_regions_in_profile_text(base, t.front().nx, t.front().ny));
+        std::printf("wrote %s\n", to.write.c_str());
+      }
+      return 0;
+    }
     if (prof->parsed()) {
       if (print_default) {
         std::cout << app::default_profile_text();

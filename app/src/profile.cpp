@@ -550,9 +550,9 @@ std::pair<int, int> auto_region_grid(const geom::SolidSpec& solid, double max_to
   } else {
     wx = wy = solid.cylinder.diameter_mm;
   }
-  // Regions of about three tool diameters keep a single sweep within few regions while the
+  // Regions of about 2.5 tool diameters keep a single sweep within few regions while the
   // polygons per region stay small; capped at 16 per axis (see docs/profiles.md).
-  const double side = std::max(3.0 * max_tool_diameter_mm, 1.0);
+  const double side = std::max(2.5 * max_tool_diameter_mm, 1.0);
   auto n = [&](double w) { return std::clamp(static_cast<int>(std::lround(w / side)), 1, 16); };
   return {n(wx), n(wy)};
 }
