@@ -39,3 +39,23 @@ TEST(Tune, WritesRegionsIntoProfileText) {
   EXPECT_EQ(q.solid.regions_x, 8);
   EXPECT_EQ(q.solid.regions_y, 8);
 }
+
+TEST(Memory, RepeatedRunsDoNotGrowThePeak) {
+  // The kernel frees and reuses what it allocates: after the first run of the demo, further
+  // runs in the same process must not raise the peak resident set by more than 5 %.
+  app::Profile p = app::default_profile();
+  p.threads = 1;
+  const nc::Toolpath tp = app::demo_toolpath();
+  double removed = 0.0;
+  {
+    const app::BatchResult r = app::run_batch(p, tp);
+    removed = r.removed_volume_mm3;
+  }
+  const double first = app::peak_rss_mb();
+  for (int i = 0; i < 3; ++i) {
+    const app::BatchResult r = app::run_batch(p, tp);
+    EXPECT_DOUBLE_EQ(r.removed_volume_mm3, removed);
+  }
+  const double after = app::peak_rss_mb();
+  EXPECT_LE(after, first * 1.05) << "peak RSS " << first << " MB -> " << after << " MB";
+}
