@@ -124,7 +124,9 @@ TEST(LiveRun, EmulatorWithToolChangesMatchesBatch) {
 TEST(LiveRun, StraightRunsMergeIntoOneSweepPerBatch) {
   // One straight cut: every chunk of samples (lbr.batch_moves in a non-live run) is
   // collinear, so each batch subtracts a single sweep, and the volume is the batch volume.
-  const app::Profile p = app::default_profile();
+  // Chunks of 64 samples, as the test was written for (the default is larger).
+  app::Profile p = app::default_profile();
+  p.batch_moves = 64;
   const std::string program = "lbr-moves 1\nstart 5 20 5\ntool 1\nfeed 3000\nrapid 5 20 -2\nline 95 20 -2\n";
   const std::string dir = testing::TempDir() + "/lbr_live_line";
   std::filesystem::create_directories(dir);

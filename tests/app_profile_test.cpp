@@ -82,7 +82,7 @@ TEST(Profile, CommandLineOverrides) {
 TEST(Profile, AutoRegionGrid) {
   geom::SolidSpec s;
   s.box = {{0, 0, 0}, {100, 80, 10}};
-  EXPECT_EQ(app::auto_region_grid(s, 10.0), std::make_pair(4, 3));
+  EXPECT_EQ(app::auto_region_grid(s, 10.0), std::make_pair(4, 4));
   EXPECT_EQ(app::auto_region_grid(s, 2.0), std::make_pair(16, 16));
 }
 

@@ -40,16 +40,27 @@ struct Tooling {
     throw std::runtime_error(path.source + ":" + std::to_string(line) + ": tool " + std::to_string(tool) +
                              " is not in the tool table of " + profile.source);
   }
+  std::map<int, std::size_t> motions;  // motion segments per milling tool
+
   void need_all(const Profile& profile, const nc::Toolpath& path) {
     for (const nc::Segment& s : path.segments) {
       if (s.kind != nc::SegmentKind::Rapid && s.kind != nc::SegmentKind::Feed && s.kind != nc::SegmentKind::ToolChange)
         continue;
       need(profile, path, s.tool, s.line);
+      if (s.kind != nc::SegmentKind::ToolChange && cutters.count(s.tool)) ++motions[s.tool];
     }
   }
-  [[nodiscard]] double max_diameter() const {
+  // Diameter of the milling tool with the most motion segments (for a sampled program: the
+  // longest time in the spindle), which the automatic region grid is sized for.
+  [[nodiscard]] double dominant_diameter() const {
     double d = 1.0;
-    for (const auto& [n, sh] : cutters) d = std::max(d, sh.tool.diameter_mm);
+    std::size_t most = 0;
+    for (const auto& [n, count] : motions) {
+      if (count > most) {
+        most = count;
+        d = std::max(1.0, cutters.at(n).tool.diameter_mm);
+      }
+    }
     return d;
   }
 };
@@ -144,7 +155,7 @@ void path_moves(const Profile& profile, const kin::Kinematics& k, const Tooling&
 
 geom::SolidSpec solid_spec(const Profile& profile, const Tooling& tooling) {
   geom::SolidSpec spec = profile.solid;
-  if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tooling.max_diameter());
+  if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tooling.dominant_diameter());
   return spec;
 }
 

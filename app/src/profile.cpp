@@ -391,7 +391,7 @@ Profile parse_profile(const std::string& text, const std::string& name) {
     Section s(*l, "lbr", name);
     p.solid.level_spacing_mm = s.number("level_spacing_mm", 0.1, 0.001, 1000.0, "mm");
     p.solid.chord_tol_mm = s.number("chord_tolerance_mm", 0.001, 0.0001, 1.0, "mm");
-    p.batch_moves = static_cast<int>(s.integer("batch_moves", 64, 1, 100000));
+    p.batch_moves = static_cast<int>(s.integer("batch_moves", 256, 1, 100000));
     p.threads = static_cast<int>(s.integer("threads", 0, 0, 256));
     if (const toml::node* ss = s.get("strictly_simple")) {
       const auto v = ss->value_exact<bool>();
@@ -550,10 +550,10 @@ std::pair<int, int> auto_region_grid(const geom::SolidSpec& solid, double max_to
   } else {
     wx = wy = solid.cylinder.diameter_mm;
   }
-  // Regions of about 2.5 tool diameters keep a single sweep within few regions while the
+  // Regions of at most 2.5 tool diameters keep a single sweep within few regions while the
   // polygons per region stay small; capped at 16 per axis (see docs/profiles.md).
   const double side = std::max(2.5 * max_tool_diameter_mm, 1.0);
-  auto n = [&](double w) { return std::clamp(static_cast<int>(std::lround(w / side)), 1, 16); };
+  auto n = [&](double w) { return std::clamp(static_cast<int>(std::ceil(w / side - 1e-9)), 1, 16); };
   return {n(wx), n(wy)};
 }
 
