@@ -67,10 +67,9 @@ int main(int argc, char** argv) {
   for (const std::string& w : workloads) {
     app::Profile prof = app::default_profile();
     prof.threads = threads;
-    const nc::Toolpath path =
-        nc::sampled_toolpath(app::load_toolpath(programs + "/" + w + ".ngc", prof), app::emulator_limits(prof));
-    const double machining = nc::emulated_time_s(app::load_toolpath(programs + "/" + w + ".ngc", prof),
-                                                 app::emulator_limits(prof));
+    const nc::Toolpath program = app::load_toolpath(programs + "/" + w + ".ngc", prof);
+    const nc::Toolpath path = nc::sampled_toolpath(program, app::emulator_limits(prof));
+    const double machining = nc::emulated_time_s(program, app::emulator_limits(prof));
     for (const std::string& g : grids) {
       app::apply_regions(prof, g, "--grids");
       const app::BatchResult r = app::run_batch(prof, path);

@@ -494,9 +494,9 @@ int main(int argc, char** argv) {
     if (emu->parsed()) return run_emulate_command(em);
     if (tune->parsed()) {
       const app::Profile profile = to.profile.empty() ? app::default_profile() : app::load_profile(to.profile);
-      const nc::Toolpath sampled =
-          nc::sampled_toolpath(app::load_toolpath(to.program, profile), app::emulator_limits(profile));
-      const double machining = nc::emulated_time_s(app::load_toolpath(to.program, profile), app::emulator_limits(profile));
+      const nc::Toolpath path = app::load_toolpath(to.program, profile);
+      const nc::Toolpath sampled = nc::sampled_toolpath(path, app::emulator_limits(profile));
+      const double machining = nc::emulated_time_s(path, app::emulator_limits(profile));
       double dmax = 1.0;
       for (const auto& [n, t] : profile.tools) dmax = std::max(dmax, t.diameter_mm);
       const auto grids = app::tune_candidates(profile, dmax);

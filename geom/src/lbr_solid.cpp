@@ -37,7 +37,6 @@ int interval_of(const std::vector<Coord>& b, Coord v) noexcept {
 }  // namespace
 
 LbrSolid::LbrSolid(const SolidSpec& spec) : spec_(spec), ws_(std::make_unique<SubtractWorkspace>()) {
-  std::ostringstream m;
   require(std::isfinite(spec.level_spacing_mm) && spec.level_spacing_mm >= 0.001 && spec.level_spacing_mm <= 1000.0,
           "level spacing must be in [0.001, 1000] mm");
   require(spec.regions_x >= 1 && spec.regions_x <= kMaxRegionsPerAxis && spec.regions_y >= 1 &&
@@ -591,10 +590,8 @@ std::string LbrSolid::check_invariants() const {
         if (!(p.bbox == bounds_of(p.outer.pts))) return where() + ": stale bounding box";
         for (const Contour& h : p.holes)
           if (ClipperLib::Area(h.pts) >= 0.0) return where() + ": hole is not clockwise";
-        for (const Path* path = &p.outer.pts; path != nullptr; path = nullptr) {
-          for (const Point& q : *path)
-            if (q.X < rr.x0 || q.X > rr.x1 || q.Y < rr.y0 || q.Y > rr.y1) return where() + ": vertex outside its region";
-        }
+        for (const Point& q : p.outer.pts)
+          if (q.X < rr.x0 || q.X > rr.x1 || q.Y < rr.y0 || q.Y > rr.y1) return where() + ": vertex outside its region";
         // A simple contour is its own simplification, with the same area.
         auto simple = [](const Path& path) {
           Paths out;

@@ -23,28 +23,16 @@ using namespace lbr;
 
 int main(int argc, char** argv) {
   CLI::App cli{"lbr-feed-can — send a program's axis samples as CANopen-style SYNC + TPDOs"};
-  std::string program, profile_path, iface = "vcan0";
-  double speed = 1.0;
+  std::string iface = "vcan0";
   bool status_word = false;
-  std::size_t max_samples = 0;
-  int priority = 0;
-  tools::FaultPlan f;
-  cli.add_option("--program", program, "Move list (.moves); default: the bundled demo");
-  cli.add_option("--profile", profile_path, "Profile (period, [[live.axis]] mapping, [live.can]); default: built-in");
+  tools::FeedOptions o;
+  tools::add_feed_options(cli, o, 0.001, "1 = real time");
   cli.add_option("--iface", iface, "CAN interface")->capture_default_str();
-  cli.add_option("--speed", speed, "1 = real time")->check(CLI::Range(0.001, 1000.0));
   cli.add_flag("--statusword", status_word, "Send 6-byte TPDOs with a statusword");
-  cli.add_option("--corrupt-every", f.corrupt_every, "Every Nth TPDO with a wrong DLC");
-  cli.add_option("--drop-every", f.drop_every, "Leave out every Nth TPDO");
-  cli.add_option("--duplicate-every", f.duplicate_every, "Send every Nth TPDO twice");
-  cli.add_option("--seed", f.seed, "Seed of the fault injection");
-  cli.add_option("--max-samples", max_samples, "Stop after this many samples (0 = whole program)");
-  cli.add_option("--priority", priority, "Run the sending loop SCHED_FIFO at this priority (0 = normal)")->check(CLI::Range(0, 99));
   CLI11_PARSE(cli, argc, argv);
+  const tools::FaultPlan& f = o.faults;
   try {
-    const app::Profile profile = profile_path.empty() ? app::default_profile() : app::load_profile(profile_path);
-    tools::Stream stream = tools::make_stream(profile, program);
-    if (max_samples > 0 && stream.counts.size() > max_samples) stream.counts.resize(max_samples);
+    const auto [profile, stream] = tools::load_feed(o);
     const int s = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
     if (s < 0) throw std::runtime_error(std::string("socket(PF_CAN): ") + std::strerror(errno));
     ifreq ifr{};
@@ -65,12 +53,12 @@ int main(int argc, char** argv) {
       return true;
     };
     std::uint64_t syncs = 0, tpdos = 0, corrupted = 0, dropped = 0, duplicated = 0, k_tpdo = 0;
-    if (priority > 0) (void)sched::configure_current_thread(sched::RtConfig{"lbr-feed", priority, -1, true});
+    if (o.priority > 0) (void)sched::configure_current_thread(sched::RtConfig{"lbr-feed", o.priority, -1, true});
     const std::int64_t t0 = sched::now_ns();
     const auto period_ns = static_cast<std::int64_t>(stream.period_s * 1e9);
     int counter = 0;
     for (std::size_t k = 0; k < stream.counts.size(); ++k) {
-      sched::sleep_until_ns(t0 + static_cast<std::int64_t>(static_cast<double>(k) * static_cast<double>(period_ns) / speed));
+      sched::sleep_until_ns(t0 + static_cast<std::int64_t>(static_cast<double>(k) * static_cast<double>(period_ns) / o.speed));
       can_frame sy{};
       sy.can_id = profile.live.can.sync_id;
       counter = counter % profile.live.can.sync_counter_max + 1;

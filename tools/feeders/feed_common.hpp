@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
@@ -50,6 +52,36 @@ inline Stream make_stream(const app::Profile& profile, const std::string& progra
     s.counts.push_back(std::move(row));
   } while (emu.next(smp));
   return s;
+}
+
+// Options both feeders take; each adds its own transport options.
+struct FeedOptions {
+  std::string program, profile_path;
+  double speed = 1.0;
+  std::size_t max_samples = 0;
+  int priority = 0;
+  FaultPlan faults;
+};
+
+inline void add_feed_options(CLI::App& cli, FeedOptions& o, double min_speed, const char* speed_help) {
+  cli.add_option("--program", o.program, "Move list (.moves) or G-code; default: the bundled demo");
+  cli.add_option("--profile", o.profile_path, "Profile (period, [[live.axis]] mapping, [live.can]); default: built-in");
+  cli.add_option("--speed", o.speed, speed_help)->check(CLI::Range(min_speed, 1000.0));
+  cli.add_option("--corrupt-every", o.faults.corrupt_every, "Damage every Nth frame (serial: one flipped bit; CAN: wrong DLC)");
+  cli.add_option("--drop-every", o.faults.drop_every, "Leave out every Nth frame (CAN: TPDO)");
+  cli.add_option("--duplicate-every", o.faults.duplicate_every, "Send every Nth frame (CAN: TPDO) twice");
+  cli.add_option("--seed", o.faults.seed, "Seed of the fault injection");
+  cli.add_option("--max-samples", o.max_samples, "Stop after this many samples (0 = whole program)");
+  cli.add_option("--priority", o.priority, "Run the sending loop SCHED_FIFO at this priority (0 = normal)")
+      ->check(CLI::Range(0, 99));
+}
+
+// The profile and the (possibly shortened) sample stream of the options' program.
+inline std::pair<app::Profile, Stream> load_feed(const FeedOptions& o) {
+  app::Profile profile = o.profile_path.empty() ? app::default_profile() : app::load_profile(o.profile_path);
+  Stream stream = make_stream(profile, o.program);
+  if (o.max_samples > 0 && stream.counts.size() > o.max_samples) stream.counts.resize(o.max_samples);
+  return {std::move(profile), std::move(stream)};
 }
 
 }  // namespace lbr::tools

@@ -44,35 +44,23 @@ bool write_all(int fd, const std::uint8_t* p, std::size_t n) {
 
 int main(int argc, char** argv) {
   CLI::App cli{"lbr-feed-serial — send a program's axis samples as serial frames"};
-  std::string program, profile_path, device, pty_link;
-  double speed = 1.0;
+  std::string device, pty_link;
   int wait_ms = 10000;
-  std::size_t max_samples = 0;
-  int priority = 0;
-  tools::FaultPlan f;
-  cli.add_option("--program", program, "Move list (.moves); default: the bundled demo");
-  cli.add_option("--profile", profile_path, "Profile (period, [[live.axis]] mapping); default: built-in");
+  tools::FeedOptions o;
+  tools::add_feed_options(cli, o, 0.0, "1 = real time, 0 = as fast as the reader takes it");
   auto* dev = cli.add_option("--device", device, "Serial device to write to");
   cli.add_option("--pty-link", pty_link, "Create a pseudo-terminal and make PATH a symlink to its slave side")->excludes(dev);
-  cli.add_option("--speed", speed, "1 = real time, 0 = as fast as the reader takes it")->check(CLI::Range(0.0, 1000.0));
   cli.add_option("--wait-reader-ms", wait_ms, "With --pty-link: wait this long for the reader to open the slave");
-  cli.add_option("--corrupt-every", f.corrupt_every, "Flip a bit in every Nth frame");
-  cli.add_option("--garbage-every", f.garbage_every, "Insert random garbage before every Nth frame");
-  cli.add_option("--truncate-every", f.truncate_every, "Cut every Nth frame short");
-  cli.add_option("--drop-every", f.drop_every, "Leave out every Nth frame");
-  cli.add_option("--duplicate-every", f.duplicate_every, "Send every Nth frame twice");
-  cli.add_option("--seed", f.seed, "Seed of the fault injection");
-  cli.add_option("--max-samples", max_samples, "Stop after this many samples (0 = whole program)");
-  cli.add_option("--priority", priority, "Run the sending loop SCHED_FIFO at this priority (0 = normal)")->check(CLI::Range(0, 99));
+  cli.add_option("--garbage-every", o.faults.garbage_every, "Insert random garbage before every Nth frame");
+  cli.add_option("--truncate-every", o.faults.truncate_every, "Cut every Nth frame short");
   CLI11_PARSE(cli, argc, argv);
   if (device.empty() == pty_link.empty()) {
     std::fprintf(stderr, "lbr-feed-serial: give --device or --pty-link\n");
     return 2;
   }
   try {
-    const app::Profile profile = profile_path.empty() ? app::default_profile() : app::load_profile(profile_path);
-    tools::Stream stream = tools::make_stream(profile, program);
-    if (max_samples > 0 && stream.counts.size() > max_samples) stream.counts.resize(max_samples);
+    const auto [profile, stream] = tools::load_feed(o);
+    const tools::FaultPlan& f = o.faults;
     int fd = -1;
     if (!pty_link.empty()) {
       int master = -1, slave = -1;
@@ -103,13 +91,13 @@ int main(int argc, char** argv) {
 
     std::mt19937_64 rng(f.seed);
     std::uint64_t sent = 0, corrupted = 0, garbage = 0, truncated = 0, dropped = 0, duplicated = 0;
-    if (priority > 0) (void)sched::configure_current_thread(sched::RtConfig{"lbr-feed", priority, -1, true});
+    if (o.priority > 0) (void)sched::configure_current_thread(sched::RtConfig{"lbr-feed", o.priority, -1, true});
     const std::int64_t t0 = sched::now_ns();
     const auto period_ns = static_cast<std::int64_t>(stream.period_s * 1e9);
     int n_pos = 0;
     for (const hal::AxisMap& m : profile.live.axes) n_pos = std::max(n_pos, m.index + 1);
     for (std::size_t k = 0; k < stream.counts.size(); ++k) {
-      if (speed > 0) sched::sleep_until_ns(t0 + static_cast<std::int64_t>(static_cast<double>(k) * static_cast<double>(period_ns) / speed));
+      if (o.speed > 0) sched::sleep_until_ns(t0 + static_cast<std::int64_t>(static_cast<double>(k) * static_cast<double>(period_ns) / o.speed));
       hal::SerialFrame fr;
       fr.seq = static_cast<std::uint32_t>(k);
       fr.t_us = static_cast<std::uint64_t>((sched::now_ns() - t0) / 1000);
