@@ -2,6 +2,9 @@
 // vertical fast path and the general support-function path.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
+
 #include "geom/sweep.hpp"
 #include "test_util.hpp"
 
@@ -131,4 +134,77 @@ TEST(Sweep, StadiumFastPathAgreesWithGeneralPathInAnyDirection) {
       EXPECT_NEAR(section_area_mm2(gen, z), exact, 2 * (14.0 + 2 * test::kPi * r) * kTol) << deg << " " << z;
     }
   }
+}
+
+// Ramp sections (several disks of different radii along the move) against the exact
+// section of the piecewise-linear tool: the section is convex and counter-clockwise, and its
+// support value in every direction equals max over t of c(t)·u + r(z - z(t)) within the
+// polygonisation band. Random moves from a fixed seed, every tool kind, steep and shallow.
+TEST(Sweep, RampSectionsMatchTheExactSupportFunction) {
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  auto uni = [&](double lo, double hi) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  const std::vector<geom::Tool> tools{test::tool(ToolKind::Ball, 6), test::tool(ToolKind::Bull, 12, 2),
+                                      test::tool(ToolKind::Drill, 8, 118), test::tool(ToolKind::VBit, 10, 90),
+                                      test::tool(ToolKind::Flat, 10), test::tool(ToolKind::Ball, 1)};
+  int checked = 0;
+  for (const auto& t : tools) {
+    const auto shape = geom::CutterShape::build(t, kTol);
+    for (int m = 0; m < 40; ++m) {
+      const double len = m % 4 == 0 ? uni(0.0, 0.05) : uni(0.1, 12.0);
+      const double ang = uni(0.0, 2 * test::kPi);
+      const double dz = m % 5 == 0 ? uni(-20.0, 20.0) : uni(-2.0, 2.0);
+      const geom::Vec3 a{uni(-5, 5), uni(-5, 5), 0.0};
+      const geom::Vec3 b{a.x + len * std::cos(ang), a.y + len * std::sin(ang), dz};
+      const geom::Sweep s(shape, test::at(a.x, a.y, a.z), test::at(b.x, b.y, b.z));
+      const double z = uni(std::min(a.z, b.z) - 0.5, std::max(a.z, b.z) + shape.height() * 0.5);
+      geom::Paths out;
+      geom::SectionScratch sc;
+      s.section(z, out, sc);
+      // The support value c(t)·u + r(z - z(t)) is piecewise linear in t (linear profile),
+      // so its maximum lies at t = 0, 1, or where the plane meets a profile station or an
+      // end of the cutting part.
+      std::vector<double> ts{0.0, 1.0};
+      if (b.z != a.z) {
+        for (const auto& st : shape.stations) ts.push_back((z - st.h - a.z) / (b.z - a.z));
+        ts.push_back((z - a.z) / (b.z - a.z));
+      }
+      std::vector<std::array<double, 3>> disks;  // x, y, r
+      for (double tt : ts) {
+        if (!(tt >= 0.0 && tt <= 1.0)) continue;
+        const double h = z - (a.z + (b.z - a.z) * tt);
+        if (h < -1e-12 || h > shape.height() + 1e-12) continue;
+        disks.push_back({a.x + (b.x - a.x) * tt, a.y + (b.y - a.y) * tt, shape.radius_at(std::clamp(h, 0.0, shape.height()))});
+      }
+      double rmax = 0.0;
+      for (const auto& d : disks) rmax = std::max(rmax, d[2]);
+      if (disks.empty() || rmax < 0.01) continue;
+      ASSERT_EQ(out.size(), 1u) << geom::to_string(t.kind) << " move " << m;
+      const geom::Path& p = out[0];
+      ASSERT_GE(p.size(), 3u);
+      for (std::size_t i = 0; i < p.size(); ++i) {  // convex, counter-clockwise (within rounding)
+        const auto& o = p[i];
+        const auto& q = p[(i + 1) % p.size()];
+        const auto& w = p[(i + 2) % p.size()];
+        const double ex = static_cast<double>(q.X - o.X), ey = static_cast<double>(q.Y - o.Y);
+        const double cr = ex * static_cast<double>(w.Y - o.Y) - ey * static_cast<double>(w.X - o.X);
+        const double fx = static_cast<double>(w.X - q.X), fy = static_cast<double>(w.Y - q.Y);
+        ASSERT_GE(cr, -1.5 * (std::hypot(ex, ey) + std::hypot(fx, fy))) << geom::to_string(t.kind) << " move " << m << " vertex " << i;
+      }
+      const int n = geom::Sweep::circle_segments(rmax, kTol);
+      const double band = rmax * (2.0 / (1.0 + std::cos(test::kPi / n)) - 1.0);
+      for (int k = 0; k < 720; ++k) {
+        const double ux = std::cos(k * test::kPi / 360), uy = std::sin(k * test::kPi / 360);
+        double exact = -INFINITY;
+        for (const auto& d : disks) exact = std::max(exact, d[0] * ux + d[1] * uy + d[2]);
+        double poly = -INFINITY;
+        for (const auto& v : p) poly = std::max(poly, geom::to_mm(v.X) * ux + geom::to_mm(v.Y) * uy);
+        ASSERT_NEAR(poly, exact, band + 2e-4) << geom::to_string(t.kind) << " move " << m << " dir " << k;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 150);
 }

@@ -244,16 +244,7 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
   // Vertices at ρ = 2r / (1 + cos(π/n)): the polygon then deviates from the circle by at
   // most ±(ρ - r), i.e. half the chord band, on either side.
   const double grow = 2.0 / (1.0 + std::cos(std::numbers::pi / n));
-  if (sc.table_n != n) {
-    sc.cos_t.resize(n);
-    sc.sin_t.resize(n);
-    for (int k = 0; k < n; ++k) {
-      const double a = 2.0 * std::numbers::pi * k / n;
-      sc.cos_t[k] = std::cos(a);
-      sc.sin_t[k] = std::sin(a);
-    }
-    sc.table_n = n;
-  }
+  const std::vector<P2>& uc = sc.unit_circle(n);
   sc.hull.clear();
   if (sc.disks.size() == 2 && sc.disks[0].r == sc.disks[1].r) {
     // Horizontal move (the common case): the hull of two equal n-gons on one angle grid is
@@ -264,7 +255,7 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
     const double dx = b.x - a.x, dy = b.y - a.y;
     const double rho = a.r * grow;
     if (dx == 0.0 && dy == 0.0) {
-      for (int k = 0; k < n; ++k) sc.hull.push_back({a.x + rho * sc.cos_t[k], a.y + rho * sc.sin_t[k]});
+      for (int k = 0; k < n; ++k) sc.hull.push_back({a.x + rho * uc[k].x, a.y + rho * uc[k].y});
     } else {
       // The side edges join the two polygons' extreme vertices in the directions normal to
       // the motion: grid indices k_right (θ - 90°) and k_left (θ + 90°).
@@ -277,43 +268,120 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
       const int k_right = nearest(th - 0.5 * std::numbers::pi);
       const int k_left = nearest(th + 0.5 * std::numbers::pi);
       for (int k = k_right;; k = (k + 1) % n) {  // front half: end disk
-        sc.hull.push_back({b.x + rho * sc.cos_t[k], b.y + rho * sc.sin_t[k]});
+        sc.hull.push_back({b.x + rho * uc[k].x, b.y + rho * uc[k].y});
         if (k == k_left) break;
       }
       for (int k = k_left;; k = (k + 1) % n) {  // back half: start disk
-        sc.hull.push_back({a.x + rho * sc.cos_t[k], a.y + rho * sc.sin_t[k]});
+        sc.hull.push_back({a.x + rho * uc[k].x, a.y + rho * uc[k].y});
         if (k == k_right) break;
       }
     }
     return emit(sc.hull, out);
   }
-  // Several disks (ramps): only vertices whose value in their own grid direction comes
-  // close to the union's support value in that direction can be hull vertices. The support
-  // function of the union is D-Lipschitz in the direction (D bounds |p - centre|), and a
-  // vertex is extreme for some direction within ±π/n of its own, so a vertex below
-  // S_k - 2·D·π/n is strictly inside; dropping those leaves the hull unchanged and the sort
-  // small.
-  double cx = 0.0, cy = 0.0;
-  for (const auto& d : sc.disks) cx += d.x, cy += d.y;
-  cx /= static_cast<double>(sc.disks.size());
-  cy /= static_cast<double>(sc.disks.size());
-  double dmax = 0.0;
-  for (const auto& d : sc.disks) dmax = std::max(dmax, std::hypot(d.x - cx, d.y - cy) + d.r * grow);
-  const double slack = 2.0 * dmax * std::numbers::pi / n + 1e-12;
-  sc.pts.clear();
-  for (int k = 0; k < n; ++k) {
-    const double ux = sc.cos_t[k], uy = sc.sin_t[k];
-    double best = -INFINITY;
-    for (const auto& d : sc.disks) best = std::max(best, (d.x - cx) * ux + (d.y - cy) * uy + d.r * grow);
-    for (const auto& d : sc.disks) {
-      const double v = (d.x - cx) * ux + (d.y - cy) * uy + d.r * grow;
-      if (v < best - slack) continue;
-      const double rho = d.r * grow;
-      sc.pts.push_back({d.x + rho * ux, d.y + rho * uy});
+  ramp_hull(sc, n, grow, uc);
+  return emit(sc.hull, out);
+}
+
+// Hull of several n-gons on one angle grid whose centres lie on the line of motion (a ramp),
+// without sorting points. Disk d has centre c0 + s_d·e (e: unit horizontal direction of the
+// motion) and circumradius ρ_d. For a direction θ = θ_k + δ with |δ| <= π/n the support
+// point of n-gon d is its vertex k, with value c_d·u(θ) + ρ_d·cos δ. Dividing by cos δ > 0,
+// the disk that wins is the one maximising the line L_d(h) = s_d·h + ρ_d at
+//   h = e·u(θ) / cos δ = cos φ - sin φ·tan δ,   φ = θ_k - θ_e,
+// which is monotone in δ. So: build the upper envelope of the lines once (slopes sorted),
+// then for each grid direction k walk the envelope from h(-π/n) to h(+π/n) and emit vertex k
+// of each winner. As θ grows the support point runs over the hull's vertices
+// counter-clockwise, so the output is the hull in order, in O(n + disks).
+void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<P2>& uc) const {
+  double ex = to_.tip.x - from_.tip.x, ey = to_.tip.y - from_.tip.y;
+  const double len = std::hypot(ex, ey);
+  if (len > 0.0) {
+    ex /= len;
+    ey /= len;
+  } else {
+    ex = 1.0;
+    ey = 0.0;
+  }
+  auto& disks = sc.disks;
+  for (auto& d : disks) {
+    d.s = len > 0.0 ? (d.x - from_.tip.x) * ex + (d.y - from_.tip.y) * ey : 0.0;
+    d.r *= grow;  // from here on, r is the circumradius ρ
+  }
+  // Few disks (the tool's stations): insertion sort by slope, then by intercept.
+  for (std::size_t i = 1; i < disks.size(); ++i) {
+    const auto d = disks[i];
+    std::size_t j = i;
+    while (j > 0 && (disks[j - 1].s > d.s || (disks[j - 1].s == d.s && disks[j - 1].r > d.r))) {
+      disks[j] = disks[j - 1];
+      --j;
+    }
+    disks[j] = d;
+  }
+  // Upper envelope (max) of L_d(h) = s_d·h + ρ_d over all h; breaks[i] is where env[i]
+  // overtakes env[i-1].
+  auto& env = sc.env;
+  auto& br = sc.breaks;
+  env.clear();
+  br.clear();
+  auto cross_at = [&](int a, int b) { return (disks[a].r - disks[b].r) / (disks[b].s - disks[a].s); };
+  for (int i = 0; i < static_cast<int>(disks.size()); ++i) {
+    if (!env.empty() && disks[env.back()].s == disks[i].s) {  // same slope: the larger ρ (later) wins
+      env.pop_back();
+      br.pop_back();
+    }
+    while (!env.empty()) {
+      const double x = cross_at(env.back(), i);
+      if (env.size() >= 2 && x <= br.back()) {
+        env.pop_back();
+        br.pop_back();
+        continue;
+      }
+      env.push_back(i);
+      br.push_back(x);
+      break;
+    }
+    if (env.empty()) {
+      env.push_back(i);
+      br.push_back(-INFINITY);
     }
   }
-  convex_hull(sc.pts, sc.hull);
-  return emit(sc.hull, out);
+  const int m = static_cast<int>(env.size());
+  // Index of the envelope piece that wins at h.
+  auto piece = [&](double h) {
+    int lo = 0, hi = m - 1;  // br[0] = -inf <= h
+    while (lo < hi) {
+      const int mid = (lo + hi + 1) / 2;
+      if (br[mid] <= h) lo = mid;
+      else hi = mid - 1;
+    }
+    return lo;
+  };
+  const double T = std::tan(std::numbers::pi / n);
+  sc.hull.clear();
+  for (int k = 0; k < n; ++k) {
+    const double ck = uc[k].x, sk = uc[k].y;
+    const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
+    const int i0 = m == 1 ? 0 : piece(cphi + sphi * T), i1 = m == 1 ? 0 : piece(cphi - sphi * T);
+    const int step = i1 >= i0 ? 1 : -1;
+    for (int i = i0;; i += step) {
+      const auto& d = disks[env[i]];
+      sc.hull.push_back({d.x + d.r * ck, d.y + d.r * sk});
+      if (i == i1) break;
+    }
+  }
+}
+
+const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {
+  if (static_cast<std::size_t>(n) >= circles_.size()) circles_.resize(static_cast<std::size_t>(n) + 1);
+  auto& c = circles_[static_cast<std::size_t>(n)];
+  if (c.empty()) {
+    c.resize(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+      const double a = 2.0 * std::numbers::pi * k / n;
+      c[static_cast<std::size_t>(k)] = {std::cos(a), std::sin(a)};
+    }
+  }
+  return c;
 }
 
 std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) const {

@@ -31,16 +31,21 @@ struct SectionScratch {
   std::vector<P2> hull;
   struct Disk {
     double x, y, r;
+    double s = 0.0;  // position of the centre along the horizontal motion [mm]
   };
   std::vector<Disk> disks;
+  std::vector<int> env;        // upper envelope of the disks' support lines (indices)
+  std::vector<double> breaks;  // where env[i] takes over from env[i-1]
   struct Dir {
     double phi;
     P2 p;
   };
   std::vector<Dir> dirs;
-  // Unit circle for the last segment count used.
-  int table_n = 0;
-  std::vector<double> cos_t, sin_t;
+  // Unit circle with n vertices, (cos, sin) pairs, built on first use of each n.
+  [[nodiscard]] const std::vector<P2>& unit_circle(int n);
+
+ private:
+  std::vector<std::vector<P2>> circles_;
 };
 
 class Sweep {
@@ -70,6 +75,7 @@ class Sweep {
  private:
   std::size_t section_vertical(double z_mm, Paths& out, SectionScratch& scratch) const;
   std::size_t section_general(double z_mm, Paths& out, SectionScratch& scratch) const;
+  void ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<SectionScratch::P2>& uc) const;
 
   const CutterShape* shape_;
   Pose from_, to_;
