@@ -208,3 +208,106 @@ TEST(Sweep, RampSectionsMatchTheExactSupportFunction) {
   }
   EXPECT_GT(checked, 150);
 }
+
+namespace {
+
+double area_units(const geom::Paths& ps, ClipperLib::ClipType op = ClipperLib::ctUnion, const geom::Paths& clip = {}) {
+  ClipperLib::Clipper c;
+  c.AddPaths(ps, ClipperLib::ptSubject, true);
+  if (!clip.empty()) c.AddPaths(clip, ClipperLib::ptClip, true);
+  geom::Paths u;
+  c.Execute(op, u, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  double a = 0.0;
+  for (const auto& p : u) a += ClipperLib::Area(p);
+  return a;
+}
+
+double perimeter_units(const geom::Path& p) {
+  double l = 0.0;
+  for (std::size_t i = 0, j = p.size() - 1; i < p.size(); j = i++)
+    l += std::hypot(static_cast<double>(p[i].X - p[j].X), static_cast<double>(p[i].Y - p[j].Y));
+  return l;
+}
+
+}  // namespace
+
+// trim_covered() on the sections of two consecutive moves: b' ⊆ b, a ∪ b' = a ∪ b, and for
+// moves that continue each other about half of b's vertices go.
+TEST(Sweep, TrimCoveredKeepsTheUnionOfConsecutiveSections) {
+  std::uint64_t state = 12345;
+  auto uni = [&](double lo, double hi) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  std::size_t before = 0, after = 0;
+  int dropped = 0, checked = 0;
+  for (const auto& t : {test::tool(ToolKind::Ball, 6), test::tool(ToolKind::Flat, 10), test::tool(ToolKind::Bull, 12, 2),
+                        test::tool(ToolKind::VBit, 10, 90)}) {
+    const auto shape = geom::CutterShape::build(t, kTol);
+    for (int m = 0; m < 60; ++m) {
+      const geom::Vec3 p0{uni(-3, 3), uni(-3, 3), uni(-1, 1)};
+      const double ang = uni(0, 2 * test::kPi), turn = m % 3 == 0 ? uni(-3.0, 3.0) : uni(-0.3, 0.3);
+      const double l1 = uni(0.5, 8), l2 = m % 7 == 0 ? uni(0.0, 0.2) : uni(0.5, 8);
+      const geom::Vec3 p1{p0.x + l1 * std::cos(ang), p0.y + l1 * std::sin(ang), p0.z + uni(-1, 1)};
+      const geom::Vec3 p2{p1.x + l2 * std::cos(ang + turn), p1.y + l2 * std::sin(ang + turn), p1.z + (m % 2 ? 0.0 : uni(-1, 1))};
+      const geom::Sweep sa(shape, test::at(p0.x, p0.y, p0.z), test::at(p1.x, p1.y, p1.z));
+      const geom::Sweep sb(shape, test::at(p1.x, p1.y, p1.z), test::at(p2.x, p2.y, p2.z));
+      const double z = uni(std::max(p0.z, std::max(p1.z, p2.z)) - 0.5, std::max(p0.z, std::max(p1.z, p2.z)) + 4.0);
+      geom::Paths a, b;
+      geom::SectionScratch sc;
+      sa.section(z, a, sc);
+      const geom::Capsule cap = sc.core;
+      sb.section(z, b, sc);
+      if (a.size() != 1 || b.size() != 1 || !cap.valid()) continue;
+      // The capsule lies inside a's polygon.
+      geom::Paths capsule;
+      double cap_perimeter = 0.0;
+      for (int i = 0; i <= 10; ++i) {  // the capsule is the union of the interpolated disks
+        const double w = i / 10.0;
+        const double cx = cap.x1 + w * (cap.x2 - cap.x1), cy = cap.y1 + w * (cap.y2 - cap.y1);
+        const double r = cap.r1 + w * (cap.r2 - cap.r1);
+        geom::Path c;
+        for (int k = 0; k < 64; ++k)
+          c.push_back({geom::to_units(cx + r * std::cos(k * test::kPi / 32)), geom::to_units(cy + r * std::sin(k * test::kPi / 32))});
+        cap_perimeter += perimeter_units(c);
+        capsule.push_back(c);
+      }
+      ASSERT_LE(area_units(capsule, ClipperLib::ctDifference, a), cap_perimeter) << "move " << m;
+      geom::Path trimmed = b[0];
+      std::vector<std::uint8_t> flags;
+      const bool keep = geom::trim_covered(trimmed, cap, flags);
+      const double slack = 2.0 * (perimeter_units(b[0]) + 10.0);
+      if (!keep) {
+        ++dropped;
+        EXPECT_LE(area_units(b, ClipperLib::ctDifference, a), slack) << "move " << m;  // b inside a
+        continue;
+      }
+      EXPECT_LE(area_units({trimmed}, ClipperLib::ctDifference, b), 1.0) << "move " << m;  // b' ⊆ b
+      geom::Paths ab = a, ab2 = a;
+      ab.push_back(b[0]);
+      ab2.push_back(trimmed);
+      EXPECT_NEAR(area_units(ab2), area_units(ab), slack) << "move " << m;
+      before += b[0].size();
+      after += trimmed.size();
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 150);
+  EXPECT_LT(static_cast<double>(after), 0.75 * static_cast<double>(before));
+  // A section wholly inside the previous one is dropped: a ball raised by 1 mm in the
+  // middle of a pass cuts a smaller disk on the plane z = 1.5.
+  const auto ball = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  const geom::Sweep pass(ball, test::at(0, 0, 0), test::at(8, 0, 0));
+  const geom::Sweep raised(ball, test::at(4, 0, 1), test::at(4.1, 0, 1));
+  geom::Paths a, b;
+  geom::SectionScratch sc;
+  pass.section(1.5, a, sc);
+  const geom::Capsule cap = sc.core;
+  raised.section(1.5, b, sc);
+  ASSERT_EQ(b.size(), 1u);
+  std::vector<std::uint8_t> flags;
+  geom::Path kept = b[0];
+  EXPECT_FALSE(geom::trim_covered(kept, cap, flags));
+  EXPECT_EQ(kept, b[0]);
+  EXPECT_EQ(dropped, 0);  // consecutive moves share a boundary, so none of the random ones
+}

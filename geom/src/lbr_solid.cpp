@@ -345,11 +345,26 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
   ws.section_box.clear();
   ws.section_id.clear();
   Rect all;
+  ws.prev_core = Capsule{};
   for (std::size_t si = 0; si < ws.sweeps.size(); ++si) {
     const Sweep& sw = ws.sweeps[si];
     if (zc < sw.z_min() || zc > sw.z_max()) continue;
     const std::size_t before = ws.sections.size();
     sw.section(zc, ws.sections, ws.scratch);
+    // Consecutive moves overlap: the vertices of this section inside the previous vertical
+    // section's capsule add edges to the clip but remove nothing more (trim_covered()).
+    if (sw.vertical() && ws.sections.size() == before + 1) {
+      if (ws.prev_core.valid()) {
+        const std::size_t vertices = ws.sections.back().size();
+        if (!trim_covered(ws.sections.back(), ws.prev_core, ws.trim_flags)) {
+          ws.sections.pop_back();
+          ++stats.sections_trimmed;
+        } else if (ws.sections.back().size() != vertices) {
+          ++stats.sections_trimmed;
+        }
+      }
+      if (ws.scratch.core.valid()) ws.prev_core = ws.scratch.core;
+    }
     for (std::size_t k = before; k < ws.sections.size(); ++k) {
       ws.section_box.push_back(bounds_of(ws.sections[k]));
       ws.section_id.push_back(ws.sweep_id[si]);

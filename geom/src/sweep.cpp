@@ -204,6 +204,7 @@ Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcep
 }
 
 std::size_t Sweep::section(double z_mm, Paths& out, SectionScratch& scratch) const {
+  scratch.core = Capsule{};
   if (z_mm < box_.lo.z || z_mm > box_.hi.z) return 0;
   return vertical_ ? section_vertical(z_mm, out, scratch) : section_general(z_mm, out, scratch);
 }
@@ -254,6 +255,9 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
     const auto& b = sc.disks[1];
     const double dx = b.x - a.x, dy = b.y - a.y;
     const double rho = a.r * grow;
+    // The n-gons contain their inscribed circles, radius ρ·cos(π/n).
+    const double r_in = rho * std::cos(std::numbers::pi / n);
+    sc.core = Capsule{a.x, a.y, r_in, b.x, b.y, r_in};
     if (dx == 0.0 && dy == 0.0) {
       for (int k = 0; k < n; ++k) sc.hull.push_back({a.x + rho * uc[k].x, a.y + rho * uc[k].y});
     } else {
@@ -279,6 +283,17 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
     return emit(sc.hull, out);
   }
   ramp_hull(sc, n, grow, uc);
+  // Capsule: the disk farthest along the motion and the largest one (or the first).
+  {
+    const auto& ds = sc.disks;  // sorted by s, radii are circumradii now
+    std::size_t big = 0;
+    for (std::size_t i = 1; i < ds.size(); ++i)
+      if (ds[i].r > ds[big].r) big = i;
+    const std::size_t last = ds.size() - 1;
+    const std::size_t other = big != last ? big : 0;
+    const double c = std::cos(std::numbers::pi / n);
+    sc.core = Capsule{ds[other].x, ds[other].y, ds[other].r * c, ds[last].x, ds[last].y, ds[last].r * c};
+  }
   return emit(sc.hull, out);
 }
 
@@ -369,6 +384,65 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
       if (i == i1) break;
     }
   }
+}
+
+bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin) {
+  const std::size_t n = b.size();
+  if (!a.valid() || n < 4) return true;
+  // The capsule in kernel units, shrunk by the margin; IQ's uneven-capsule test in the frame
+  // where c1 is the origin and the axis runs along +y.
+  const double k = kUnitsPerMm;
+  const double x1 = a.x1 * k, y1 = a.y1 * k, x2 = a.x2 * k, y2 = a.y2 * k;
+  const double r1 = a.r1 * k - margin, r2 = a.r2 * k - margin;
+  if (r1 <= 0.0 && r2 <= 0.0) return true;
+  const double dx = x2 - x1, dy = y2 - y1, h = std::hypot(dx, dy);
+  const double bx0 = std::min(x1 - r1, x2 - r2), bx1 = std::max(x1 + r1, x2 + r2);
+  const double by0 = std::min(y1 - r1, y2 - r2), by1 = std::max(y1 + r1, y2 + r2);
+  auto inside = [&](const Point& q) {
+    const double qx = static_cast<double>(q.X), qy = static_cast<double>(q.Y);
+    if (qx <= bx0 || qx >= bx1 || qy <= by0 || qy >= by1) return false;
+    if (h <= std::abs(r1 - r2)) {  // one disk holds the other
+      const bool first = r1 >= r2;
+      const double ex = qx - (first ? x1 : x2), ey = qy - (first ? y1 : y2), r = first ? r1 : r2;
+      return r > 0.0 && ex * ex + ey * ey <= r * r;
+    }
+    const double ux = dx / h, uy = dy / h;
+    const double along = (qx - x1) * ux + (qy - y1) * uy;
+    const double perp = std::abs((qx - x1) * uy - (qy - y1) * ux);
+    const double bb = (r1 - r2) / h, aa = std::sqrt(1.0 - bb * bb);
+    const double kk = -bb * perp + aa * along;
+    if (kk < 0.0) return r1 > 0.0 && perp * perp + along * along <= r1 * r1;
+    if (kk > aa * h) return r2 > 0.0 && perp * perp + (along - h) * (along - h) <= r2 * r2;
+    return aa * perp + bb * along <= r1;
+  };
+  flags.resize(n);
+  std::size_t in_count = 0, start = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool in = inside(b[i]);
+    flags[i] = in ? 1 : 0;
+    in_count += in ? 1 : 0;
+    if (!in && start == n) start = i;
+  }
+  if (start == n) return false;
+  if (in_count <= 2) return true;
+  // From an outside vertex on, keep the outside vertices and both ends of each inside run;
+  // written in place (the write index never passes the read index).
+  std::rotate(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(start), b.end());
+  std::rotate(flags.begin(), flags.begin() + static_cast<std::ptrdiff_t>(start), flags.end());
+  std::size_t w = 0, i = 0;
+  while (i < n) {
+    if (flags[i] == 0) {
+      b[w++] = b[i++];
+      continue;
+    }
+    std::size_t j = i;
+    while (j < n && flags[j] != 0) ++j;
+    b[w++] = b[i];
+    if (j - i >= 2) b[w++] = b[j - 1];
+    i = j;
+  }
+  b.resize(w);
+  return true;
 }
 
 const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {

@@ -78,9 +78,11 @@ struct SubtractStats {
   std::uint64_t cells_tested = 0;   // (region, level) pairs that passed the box tests
   std::uint64_t cells_clipped = 0;  // polygon differences executed
   std::uint64_t cells_changed = 0;  // cells whose content changed
+  std::uint64_t sections_trimmed = 0;  // sections trimmed or dropped inside the previous one
   SubtractStats& operator+=(const SubtractStats& o) noexcept {
     sections += o.sections; cells_tested += o.cells_tested;
     cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
+    sections_trimmed += o.sections_trimmed;
     return *this;
   }
 };
@@ -110,6 +112,8 @@ struct SubtractWorkspace {
   std::vector<Chain> chains;
   std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
   Paths sections;                 // section polygons of the current level
+  Capsule prev_core;                     // inside the last vertical section (trim_covered())
+  std::vector<std::uint8_t> trim_flags;
   std::vector<Rect> section_box;  // their bounding boxes
   std::vector<MoveId> section_id; // their move ids
   std::vector<std::uint32_t> selected, touched;

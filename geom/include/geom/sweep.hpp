@@ -13,6 +13,7 @@
 // sub-steps.
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -20,6 +21,13 @@
 #include "geom/types.hpp"
 
 namespace lbr::geom {
+
+// The convex hull of two disks (a tapered capsule) [mm]: a region known to lie inside a
+// section polygon, recorded by Sweep::section() for the vertical fast path.
+struct Capsule {
+  double x1 = 0, y1 = 0, r1 = -1, x2 = 0, y2 = 0, r2 = -1;
+  [[nodiscard]] bool valid() const noexcept { return r1 >= 0.0 && r2 >= 0.0; }
+};
 
 // Reusable buffers for Sweep::section(); grows to the largest section seen, then stops
 // allocating. One per thread.
@@ -41,12 +49,23 @@ struct SectionScratch {
     P2 p;
   };
   std::vector<Dir> dirs;
+  // Set by each vertical section: a capsule inside the polygon just emitted (invalid when
+  // the last section was empty or came from the general path).
+  Capsule core;
   // Unit circle with n vertices, (cos, sin) pairs, built on first use of each n.
   [[nodiscard]] const std::vector<P2>& unit_circle(int n);
 
  private:
   std::vector<std::vector<P2>> circles_;
 };
+
+// Removes from convex polygon `b` (counter-clockwise, kernel units) the vertices that lie
+// inside capsule `a` by at least `margin` units, keeping the first and last vertex of each
+// such run. What b loses is the convex hull of a run, which lies inside a, so b' ⊆ b and
+// a ∪ b' = a ∪ b: when a's polygon is removed from the stock in the same operation, b' does
+// the same work with fewer edges. Returns false when every vertex of b lies inside a (b is
+// then unchanged and can be dropped). `flags` is a reusable buffer.
+bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
 
 class Sweep {
  public:
