@@ -23,6 +23,8 @@ void require(bool ok, const std::string& what) {
 
 bool in_range(double mm) { return std::isfinite(mm) && std::abs(mm) <= kSafeRangeMm; }
 
+constexpr std::uint32_t kNoChain = 0xFFFFFFFFu;
+
 Path rect_path(const Rect& r) {
   return Path{{r.x0, r.y0}, {r.x1, r.y0}, {r.x1, r.y1}, {r.x0, r.y1}};
 }
@@ -338,12 +340,41 @@ SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int lev
   return stats;
 }
 
+// The offset of a chain cut to a region's rectangle grown by 1 mm (so that no cut edge lies on
+// the region's material), computed on first use for each radius. Within a region the clip
+// then carries only the chain's nearby edges instead of the whole offset.
+const Paths& LbrSolid::chain_region_paths(SubtractWorkspace& ws, std::uint32_t chain, int region) {
+  SubtractWorkspace::Chain& c = ws.chains[chain];
+  const std::size_t r = static_cast<std::size_t>(region);
+  if (c.region_paths.size() < c.region_ok.size()) c.region_paths.resize(c.region_ok.size());
+  if (c.region_ok[r] != 0) return c.region_paths[r];
+  Rect rr = region_rect(region);
+  const Coord grow = static_cast<Coord>(kUnitsPerMm);
+  rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
+  Paths& out = c.region_paths[r];
+  out.clear();
+  Rect whole;
+  for (const Path& p : c.cached) whole.add(bounds_of(p));
+  if (whole.x0 >= rr.x0 && whole.x1 <= rr.x1 && whole.y0 >= rr.y0 && whole.y1 <= rr.y1) {
+    out = c.cached;  // wholly inside: nothing to cut
+  } else {
+    ClipperLib::Clipper& k = ws.rect_clipper;  // ws.clipper is being filled by the caller
+    k.Clear();
+    k.AddPaths(c.cached, ClipperLib::ptSubject, true);
+    k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
+    k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  }
+  c.region_ok[r] = 1;
+  return out;
+}
+
 SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
   SubtractStats stats;
   const double zc = level_z_mm(level);
   ws.sections.clear();
   ws.section_box.clear();
   ws.section_id.clear();
+  ws.section_chain.clear();
   Rect all;
   ws.prev_core = Capsule{};
   for (std::size_t si = 0; si < ws.sweeps.size(); ++si) {
@@ -386,13 +417,19 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
       c.cached.clear();
       off.Execute(c.cached, (r + 0.25 * tol) * kUnitsPerMm);
       c.cached_r = r;
+      c.region_ok.assign(static_cast<std::size_t>(regions()), 0);
     }
-    for (const Path& p : c.cached) {
-      ws.sections.push_back(p);
-      ws.section_box.push_back(bounds_of(p));
-      ws.section_id.push_back(c.id);
-      all.add(ws.section_box.back());
-    }
+    // One entry for the whole offset (outer contours and holes): its paths are added to a
+    // clip through region_paths(), cut to the region once per radius.
+    if (c.cached.empty()) continue;
+    Rect box;
+    for (const Path& p : c.cached) box.add(bounds_of(p));
+    ws.sections.emplace_back();
+    ws.section_box.push_back(box);
+    ws.section_id.push_back(c.id);
+    ws.section_chain.resize(ws.sections.size(), kNoChain);
+    ws.section_chain.back() = static_cast<std::uint32_t>(ci);
+    all.add(box);
   }
   // Turning moves: the union of their revolved regions on this level is one region, the
   // smallest r_min (external) and the largest r_max (internal); it takes the latest move id
@@ -425,6 +462,7 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
       }
     }
   }
+  ws.section_chain.resize(ws.sections.size(), kNoChain);
   stats.sections = ws.sections.size();
   if (ws.sections.empty() || !all.intersects(xy_)) return stats;
 
@@ -458,7 +496,10 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
         c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
         for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
       }
-      for (std::uint32_t k : ws.selected) c.AddPath(ws.sections[k], ClipperLib::ptClip, true);
+      for (std::uint32_t k : ws.selected) {
+        if (ws.section_chain[k] == kNoChain) c.AddPath(ws.sections[k], ClipperLib::ptClip, true);
+        else c.AddPaths(chain_region_paths(ws, ws.section_chain[k], region), ClipperLib::ptClip, true);
+      }
       ws.tree.Clear();
       c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
       ++stats.cells_clipped;

@@ -91,6 +91,7 @@ struct SubtractStats {
 // seen and is then reused without further allocation of its own.
 struct SubtractWorkspace {
   ClipperLib::Clipper clipper;
+  ClipperLib::Clipper rect_clipper;  // cuts chain offsets to regions
   ClipperLib::PolyTree tree;
   SectionScratch scratch;
   std::vector<SweepRef> merged;   // the batch after merging collinear runs
@@ -108,6 +109,8 @@ struct SubtractWorkspace {
     MoveId id = 0;             // largest move id of the run
     double cached_r = -1.0;    // radius of `cached` [mm]
     Paths cached;
+    std::vector<std::uint8_t> region_ok;  // per region: region_paths[r] is `cached` cut to it
+    std::vector<Paths> region_paths;
   };
   std::vector<Chain> chains;
   std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
@@ -116,6 +119,7 @@ struct SubtractWorkspace {
   std::vector<std::uint8_t> trim_flags;
   std::vector<Rect> section_box;  // their bounding boxes
   std::vector<MoveId> section_id; // their move ids
+  std::vector<std::uint32_t> section_chain;  // chain index for a chain's entry, else ~0
   std::vector<std::uint32_t> selected, touched;
   std::vector<Polygon> fresh, kept;
 };
@@ -199,6 +203,7 @@ class LbrSolid {
  private:
   void init_cells();
   SubtractStats subtract_level(int level, SubtractWorkspace& ws);
+  const Paths& chain_region_paths(SubtractWorkspace& ws, std::uint32_t chain, int region);
 
   SolidSpec spec_;
   int levels_ = 0;
