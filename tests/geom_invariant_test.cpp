@@ -28,19 +28,25 @@ std::vector<geom::CutterShape> shapes() {
 }
 
 geom::LbrSolid run(const std::vector<Move>& prog, const std::vector<geom::CutterShape>& sh, int nx, int ny,
-                   geom::Vec3 shift = {}, int batch = 8) {
-  geom::LbrSolid s(test::box_spec({shift.x, shift.y, shift.z - 12}, {shift.x + 80, shift.y + 60, shift.z}, 0.2, nx, ny));
+                   geom::Vec3 shift = {}, int batch = 8, bool coherence = true, geom::SubtractStats* stats = nullptr) {
+  auto spec = test::box_spec({shift.x, shift.y, shift.z - 12}, {shift.x + 80, shift.y + 60, shift.z}, 0.2, nx, ny);
+  spec.vertical_coherence = coherence;
+  geom::LbrSolid s(spec);
   std::vector<geom::SweepRef> b;
   geom::MoveId id = 1;
   for (const Move& m : prog) {
     b.push_back({&sh[m.tool], test::at(m.a.x + shift.x, m.a.y + shift.y, m.a.z + shift.z),
                  test::at(m.b.x + shift.x, m.b.y + shift.y, m.b.z + shift.z), id++});
     if (static_cast<int>(b.size()) == batch) {
-      s.subtract(b);
+      const auto st = s.subtract(b);
+      if (stats != nullptr) *stats += st;
       b.clear();
     }
   }
-  if (!b.empty()) s.subtract(b);
+  if (!b.empty()) {
+    const auto st = s.subtract(b);
+    if (stats != nullptr) *stats += st;
+  }
   return s;
 }
 
@@ -235,5 +241,39 @@ TEST(Invariants, HorizontalRunsCutLikeTheirMoves) {
     EXPECT_NEAR(test::removed(runs), test::removed(single), 2 * outline * kTol * 4.0) << tool;
     EXPECT_GT(test::removed(runs), 100.0);
     EXPECT_EQ(runs.check_invariants(), "");
+  }
+}
+
+// Reusing the level below's result (vertical coherence) gives the same solid, contour for
+// contour, move ids and dirty cells included: a seeded mix of 2.5D steps (flat tool,
+// horizontal runs) and 3D moves of every tool.
+TEST(Invariants, VerticalCoherenceChangesNothing) {
+  const unsigned seed = seed_from_env();
+  std::mt19937 rng(seed + 7);
+  std::uniform_real_distribution<double> x(-5, 85), y(-5, 65), step(-11, -1);
+  auto prog = random_program(seed, 40);
+  for (int depth = 0; depth < 4; ++depth) {  // zig-zag step-downs
+    const double z = -1.5 - 2.0 * depth;
+    for (int k = 0; k < 6; ++k) prog.push_back({0, {10.0 + 10 * k, 15, z}, {10.0 + 10 * k, 45, z}});
+    prog.push_back({depth % 4, {x(rng), y(rng), step(rng)}, {x(rng), y(rng), step(rng)}});
+  }
+  const auto sh = shapes();
+  for (int batch : {1, 8, 64}) {
+    geom::SubtractStats st_on, st_off;
+    geom::LbrSolid on = run(prog, sh, 4, 3, {}, batch, true, &st_on);
+    geom::LbrSolid off = run(prog, sh, 4, 3, {}, batch, false, &st_off);
+    EXPECT_GE(st_on.cells_reused, 30u) << "batch " << batch;  // the 2.5D steps reuse
+    EXPECT_EQ(st_off.cells_reused, 0u);
+    EXPECT_EQ(st_on.cells_changed, st_off.cells_changed);
+    ASSERT_EQ(on.check_invariants(), "");
+    EXPECT_EQ(geom::to_bytes(on), geom::to_bytes(off)) << "batch " << batch << ", seed " << seed;
+    EXPECT_EQ(on.dirty_cells(), off.dirty_cells()) << "batch " << batch;
+    for (int r = 0; r < on.regions(); ++r)
+      for (int l = 0; l < on.levels(); ++l) {
+        ASSERT_EQ(on.cell(r, l).last_cut, off.cell(r, l).last_cut) << r << " " << l;
+        ASSERT_EQ(on.cell(r, l).polys.size(), off.cell(r, l).polys.size()) << r << " " << l;
+        for (std::size_t p = 0; p < on.cell(r, l).polys.size(); ++p)
+          ASSERT_EQ(on.cell(r, l).polys[p].outer.cut_by, off.cell(r, l).polys[p].outer.cut_by);
+      }
   }
 }

@@ -97,10 +97,21 @@ TEST(Solid, BoxCullingSkipsFarCells) {
   geom::LbrSolid s(test::box_spec({0, 0, -10}, {80, 80, 0}, 0.1, 8, 8));
   const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 4), 0.001);
   const geom::SubtractStats st = test::cut(s, c, test::at(5, 5, -1), test::at(5, 5, -1));
-  // A 4 mm tool at (5, 5) touches region 0 only, in the top 10 levels.
-  EXPECT_EQ(st.cells_tested, 10u);
-  EXPECT_EQ(st.cells_clipped, 10u);
+  // A 4 mm tool at (5, 5) touches region 0 only, in the top 10 levels: the lowest is
+  // clipped, the 9 above start from the same square with the same disk and reuse it.
   EXPECT_EQ(st.sections, 10u);
+  EXPECT_EQ(st.cells_tested, 1u);
+  EXPECT_EQ(st.cells_clipped, 1u);
+  EXPECT_EQ(st.cells_reused, 9u);
+  EXPECT_EQ(st.cells_changed, 10u);
+  auto spec = test::box_spec({0, 0, -10}, {80, 80, 0}, 0.1, 8, 8);
+  spec.vertical_coherence = false;
+  geom::LbrSolid off(spec);
+  const geom::SubtractStats so = test::cut(off, c, test::at(5, 5, -1), test::at(5, 5, -1));
+  EXPECT_EQ(so.cells_tested, 10u);
+  EXPECT_EQ(so.cells_clipped, 10u);
+  EXPECT_EQ(so.cells_reused, 0u);
+  EXPECT_EQ(so.cells_changed, 10u);
 }
 
 TEST(Solid, BooleanDifferenceOfTwoSolids) {

@@ -398,6 +398,11 @@ Profile parse_profile(const std::string& text, const std::string& name) {
       if (!v) s.fail(ss, "strictly_simple", "expected true or false");
       p.solid.strictly_simple = *v;
     }
+    if (const toml::node* vc = s.get("vertical_coherence")) {
+      const auto v = vc->value_exact<bool>();
+      if (!v) s.fail(vc, "vertical_coherence", "expected true or false");
+      p.solid.vertical_coherence = *v;
+    }
     if (const toml::node* r = s.get("regions")) {
       const auto v = r->value_exact<std::string>();
       if (!v) s.fail(r, "regions", "expected a string \"NXxNY\" or \"auto\"");

@@ -25,6 +25,21 @@ bool in_range(double mm) { return std::isfinite(mm) && std::abs(mm) <= kSafeRang
 
 constexpr std::uint32_t kNoChain = 0xFFFFFFFFu;
 
+bool same_contour(const Contour& a, const Contour& b) noexcept { return a.cut_by == b.cut_by && a.pts == b.pts; }
+
+// Vertex for vertex the same polygons, move ids included (cheap tests first).
+bool same_polygons(const Cell& a, const Cell& b) noexcept {
+  if (a.polys.size() != b.polys.size() || !(a.bbox == b.bbox) || a.area_units2 != b.area_units2) return false;
+  for (std::size_t i = 0; i < a.polys.size(); ++i) {
+    const Polygon& p = a.polys[i];
+    const Polygon& q = b.polys[i];
+    if (p.holes.size() != q.holes.size() || !same_contour(p.outer, q.outer)) return false;
+    for (std::size_t h = 0; h < p.holes.size(); ++h)
+      if (!same_contour(p.holes[h], q.holes[h])) return false;
+  }
+  return true;
+}
+
 Path rect_path(const Rect& r) {
   return Path{{r.x0, r.y0}, {r.x1, r.y0}, {r.x1, r.y1}, {r.x0, r.y1}};
 }
@@ -336,7 +351,18 @@ SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int lev
   const int first = level_at(zlo);
   if (lb < first) lb += (first - lb + stride - 1) / stride * stride;
   const int le = std::min(level_end, level_at(zhi) + 1);
-  for (int l = lb; l < le; l += stride) stats += subtract_level(l, ws);
+  ws.prev_level = -1;
+  ws.prev_sections.clear();
+  if (ws.same_below.size() != static_cast<std::size_t>(regions())) {
+    ws.same_below.assign(static_cast<std::size_t>(regions()), -1);
+    ws.outcome.assign(static_cast<std::size_t>(regions()), 0);
+  }
+  std::fill(ws.same_below.begin(), ws.same_below.end(), -1);
+  for (int l = lb; l < le; l += stride) {
+    ws.next_level = spec_.vertical_coherence && l + stride < le ? l + stride : -1;
+    stats += subtract_level(l, ws);
+    ws.prev_level = l;
+  }
   return stats;
 }
 
@@ -464,6 +490,25 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
   }
   ws.section_chain.resize(ws.sections.size(), kNoChain);
   stats.sections = ws.sections.size();
+  // Same sections as the previous visited level: same paths, same chain radii (the chains'
+  // offsets are cached per radius, so equal radii mean equal offsets).
+  ws.same_sections = false;
+  if (spec_.vertical_coherence) {
+    bool same = ws.prev_level >= 0 && ws.sections == ws.prev_sections && ws.prev_chain_r.size() == ws.chain_count;
+    for (std::size_t ci = 0; same && ci < ws.chain_count; ++ci) {
+      const double h = zc - ws.chains[ci].z;
+      const bool active = h >= 0.0 && h <= ws.chains[ci].shape->height();
+      same = (active ? ws.chains[ci].cached_r : -2.0) == ws.prev_chain_r[ci];
+    }
+    ws.same_sections = same;
+    ws.prev_sections = ws.sections;
+    ws.prev_chain_r.resize(ws.chain_count);
+    for (std::size_t ci = 0; ci < ws.chain_count; ++ci) {
+      const double h = zc - ws.chains[ci].z;
+      const bool active = h >= 0.0 && h <= ws.chains[ci].shape->height();
+      ws.prev_chain_r[ci] = active ? ws.chains[ci].cached_r : -2.0;
+    }
+  }
   if (ws.sections.empty() || !all.intersects(xy_)) return stats;
 
   const int ix0 = interval_of(xs_, all.x0), ix1 = interval_of(xs_, all.x1);
@@ -473,6 +518,29 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
       const int region = iy * spec_.regions_x + ix;
       const std::size_t ci = static_cast<std::size_t>(region) * levels_ + level;
       Cell& cell = cells_[ci];
+      if (spec_.vertical_coherence) {
+        // Same start as the previous visited level and same sections: same result. Look
+        // ahead first, while this cell still holds its start.
+        const bool reuse = ws.same_sections && ws.same_below[region] == level;
+        ws.same_below[region] = -1;
+        if (ws.next_level >= 0 && same_polygons(cell, cells_[static_cast<std::size_t>(region) * levels_ + ws.next_level]))
+          ws.same_below[region] = ws.next_level;
+        if (reuse) {
+          ++stats.cells_reused;
+          if (ws.outcome[region] != 0) {
+            const Cell& below = cells_[static_cast<std::size_t>(region) * levels_ + ws.prev_level];
+            cell.polys = below.polys;
+            cell.bbox = below.bbox;
+            cell.area_units2 = below.area_units2;
+            cell.last_cut = below.last_cut;
+            ++cell.version;
+            dirty_flag_[ci] = 1;
+            ++stats.cells_changed;
+          }
+          continue;
+        }
+        ws.outcome[region] = 0;
+      }
       if (!cell.bbox.intersects(all)) continue;
       ++stats.cells_tested;
       ws.selected.clear();
@@ -576,6 +644,7 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
       ++cell.version;
       dirty_flag_[ci] = 1;
       ++stats.cells_changed;
+      ws.outcome[region] = 1;
     }
   }
   return stats;

@@ -59,6 +59,10 @@ struct SolidSpec {
   int regions_x = 4, regions_y = 4;
   double chord_tol_mm = 0.001;    // polygonisation of the cylinder's circle
   bool strictly_simple = false;   // ask Clipper for strictly simple output (no touching vertices)
+  // Reuse the result of the level below when a cell starts from the same polygons and the
+  // level's sections are the same (2.5D work: most levels of a step repeat the one below).
+  // The result is identical either way; off only to measure or test it.
+  bool vertical_coherence = true;
 };
 
 // One tool movement to remove: the shape must outlive the call. Either a milling tool
@@ -79,10 +83,11 @@ struct SubtractStats {
   std::uint64_t cells_clipped = 0;  // polygon differences executed
   std::uint64_t cells_changed = 0;  // cells whose content changed
   std::uint64_t sections_trimmed = 0;  // sections trimmed or dropped inside the previous one
+  std::uint64_t cells_reused = 0;      // cells that took the result of the level below
   SubtractStats& operator+=(const SubtractStats& o) noexcept {
     sections += o.sections; cells_tested += o.cells_tested;
     cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
-    sections_trimmed += o.sections_trimmed;
+    sections_trimmed += o.sections_trimmed; cells_reused += o.cells_reused;
     return *this;
   }
 };
@@ -120,6 +125,15 @@ struct SubtractWorkspace {
   std::vector<Rect> section_box;  // their bounding boxes
   std::vector<MoveId> section_id; // their move ids
   std::vector<std::uint32_t> section_chain;  // chain index for a chain's entry, else ~0
+  // Vertical coherence (SolidSpec::vertical_coherence), for the levels one call visits in
+  // order (level, level + stride, ...):
+  Paths prev_sections;              // the previous visited level's sections
+  std::vector<double> prev_chain_r; // and its chains' radii
+  int prev_level = -1;              // that level (-1: none)
+  int next_level = -1;              // the level visited after the current one (-1: none)
+  bool same_sections = false;       // this level's sections equal prev_level's
+  std::vector<int> same_below;      // per region: the level whose start equals prev's start
+  std::vector<std::uint8_t> outcome;  // per region: prev_level's cell changed
   std::vector<std::uint32_t> selected, touched;
   std::vector<Polygon> fresh, kept;
 };
