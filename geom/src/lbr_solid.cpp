@@ -276,14 +276,40 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
     std::size_t j = i + 1;
     // Extend the run while the next move continues this one with the same tool and a fixed
     // axis, and every intermediate point stays within tol/2 of the merged chord.
+    //
+    // `dev` bounds the intermediate points' distance to the current chord A-E. When the end
+    // moves to E' with |E' - A| >= |E - A|, each point's nearest point A + s·u on A-E has the
+    // partner A + s·u' on A-E', |s·(u - u')| away, so dev + |E - A|·|u - u'| bounds the
+    // distance to the new chord and only E itself needs measuring: O(1) per sample on a
+    // straight stream. Where the bound exceeds tol, every point is measured again.
+    const Vec3 A = first.from.tip;
+    Vec3 u{0, 0, 0};
+    double len = 0.0, dev = 0.0;
+    {
+      const Vec3 e = first.to.tip - A;
+      len = norm(e);
+      if (len > 0.0) u = (1.0 / len) * e;
+    }
     while (j < batch.size() && j - i < kMaxRun) {
       const SweepRef& n = batch[j];
       if (n.shape != first.shape || n.turning != first.turning || !(n.from.tip == merged.to.tip) || !same_axis(n.from.axis, first.from.axis) ||
           !same_axis(n.to.axis, first.from.axis) || !same_axis(first.to.axis, first.from.axis))
         break;
-      bool ok = true;
-      for (std::size_t k = i; k < j && ok; ++k) ok = dist_to_segment(batch[k].to.tip, first.from.tip, n.to.tip) <= tol;
-      if (!ok) break;
+      const Vec3 v = n.to.tip - A;
+      const double nlen = norm(v);
+      const Vec3 nu = nlen > 0.0 ? (1.0 / nlen) * v : Vec3{0, 0, 0};
+      double bound = INFINITY;
+      if (len > 0.0 && nlen >= len) bound = std::max(dev + len * norm(u - nu), dist_to_segment(merged.to.tip, A, n.to.tip));
+      if (bound <= tol) {
+        dev = bound;
+      } else {
+        double exact = 0.0;
+        for (std::size_t k = i; k < j && exact <= tol; ++k) exact = std::max(exact, dist_to_segment(batch[k].to.tip, A, n.to.tip));
+        if (exact > tol) break;
+        dev = exact;
+      }
+      len = nlen;
+      u = nu;
       merged.to = n.to;
       merged.id = std::max(merged.id, n.id);
       ++j;
