@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One command for a newcomer and for CI: install dependencies, build, run every test;
 # then rebuild with AddressSanitizer + UndefinedBehaviorSanitizer and run the unit tests
-# again (build-asan/); then the threaded tests (ring, RT threads, live pipeline) under
+# again (build-asan/); then the threaded tests (ring, RT threads, live pipeline, worker pool) under
 # ThreadSanitizer (build-tsan/) and,
 # where clang is installed, the libFuzzer decoder targets for a fixed number of runs
 # (build-fuzz/, label fuzz). Set LBR_SKIP_SANITIZERS=1 to skip these stages locally.
@@ -21,12 +21,12 @@ if [ "${LBR_SKIP_SANITIZERS:-0}" != "1" ]; then
 fi
 
 if [ "${LBR_SKIP_SANITIZERS:-0}" != "1" ]; then
-  echo "== sanitizers: thread (ring, RT threads, live pipeline) =="
+  echo "== sanitizers: thread (ring, RT threads, live pipeline, kernel worker pool) =="
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DLBR_SANITIZE=thread -DLBR_TSAN_TESTS=ON \
         -DLBR_BUILD_BENCH=OFF -DLBR_BUILD_TESTS=ON
-  cmake --build build-tsan --parallel "$(nproc)" --target sched_ring_test sched_ring_test_tsan sched_stats_test app_live_test
+  cmake --build build-tsan --parallel "$(nproc)" --target sched_ring_test sched_ring_test_tsan sched_stats_test app_live_test app_profile_test
   TSAN_OPTIONS=halt_on_error=1 ctest --test-dir build-tsan --output-on-failure --timeout 900 \
-        -R '^(SpscRing|LatencyHistogram|RtThread|PeriodicThread|LiveRun|LiveProfile)\.|^sched_ring_test_tsan$'
+        -R '^(SpscRing|LatencyHistogram|RtThread|PeriodicThread|LiveRun|LiveProfile)\.|^Batch\.WorkerThreads|^sched_ring_test_tsan$'
   if command -v clang++ >/dev/null 2>&1; then
     echo "== fuzzers (libFuzzer, fixed runs) =="
     CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLBR_BUILD_FUZZ=ON \

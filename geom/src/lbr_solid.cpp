@@ -244,7 +244,8 @@ void LbrSolid::set_cell(int region, int level, std::vector<Polygon> polys, MoveI
 SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch) { return subtract(batch, *ws_); }
 
 SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws) {
-  return subtract_levels(batch, 0, levels_, ws);
+  static const std::function<void()> kNoSync = [] {};
+  return subtract_shared(batch, ws.own, ws, 0, 1, kNoSync);
 }
 
 namespace {
@@ -319,16 +320,17 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
   }
 }
 
-SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
-                                        SubtractWorkspace& ws, int stride) {
-  SubtractStats stats;
+// Merges the batch and builds its sweeps, chains and turning sweeps in `ws`; returns the
+// lowest height they reach (zhi: the highest), or +inf when there is nothing to cut.
+double LbrSolid::prepare(std::span<const SweepRef> batch, SubtractWorkspace& ws, double& zhi) const {
   merge_collinear(batch, ws.merged);
   ws.sweeps.clear();
   ws.sweep_id.clear();
   ws.lathe.clear();
   ws.lathe_id.clear();
   ws.chain_count = 0;
-  double zlo = INFINITY, zhi = -INFINITY;
+  double zlo = INFINITY;
+  zhi = -INFINITY;
   auto horizontal = [](const SweepRef& r) {
     return r.turning == nullptr && r.shape != nullptr && r.from.tip.z == r.to.tip.z && r.from.axis.x == 0.0 &&
            r.from.axis.y == 0.0 && r.from.axis.z > 0.0 && r.to.axis.x == 0.0 && r.to.axis.y == 0.0 && r.to.axis.z > 0.0;
@@ -371,31 +373,129 @@ SubtractStats LbrSolid::subtract_levels(std::span<const SweepRef> batch, int lev
     zlo = std::min(zlo, ws.sweeps.back().z_min());
     zhi = std::max(zhi, ws.sweeps.back().z_max());
   }
-  if ((ws.sweeps.empty() && ws.lathe.empty() && ws.chain_count == 0) || zhi < z0_ || zlo > z1_) return stats;
-  stride = std::max(stride, 1);
-  int lb = level_begin;
-  const int first = level_at(zlo);
-  if (lb < first) lb += (first - lb + stride - 1) / stride * stride;
-  const int le = std::min(level_end, level_at(zhi) + 1);
-  ws.prev_level = -1;
-  ws.prev_sections.clear();
-  if (ws.same_below.size() != static_cast<std::size_t>(regions())) {
-    ws.same_below.assign(static_cast<std::size_t>(regions()), -1);
-    ws.outcome.assign(static_cast<std::size_t>(regions()), 0);
+  return zlo;
+}
+
+SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, SubtractShared& sh, SubtractWorkspace& ws,
+                                        int index, int count, const std::function<void()>& sync) {
+  SubtractStats stats;
+  // Every thread prepares the same batch (cheap next to clipping) and derives the same range.
+  double zhi = -INFINITY;
+  const double zlo = prepare(batch, ws, zhi);
+  const bool nothing = (ws.sweeps.empty() && ws.lathe.empty() && ws.chain_count == 0) || zhi < z0_ || zlo > z1_;
+  const int lb = nothing ? 0 : level_at(zlo);
+  const int le = nothing ? 0 : level_at(zhi) + 1;
+  const int n = le - lb;
+  const std::size_t nreg = static_cast<std::size_t>(regions());
+  if (index == 0) {
+    sh.lb = lb;
+    sh.le = le;
+    if (sh.levels.size() < static_cast<std::size_t>(n)) sh.levels.resize(static_cast<std::size_t>(n));
+    sh.outcome.assign(static_cast<std::size_t>(n) * nreg, 0);
   }
-  std::fill(ws.same_below.begin(), ws.same_below.end(), -1);
-  for (int l = lb; l < le; l += stride) {
-    ws.next_level = spec_.vertical_coherence && l + stride < le ? l + stride : -1;
-    stats += subtract_level(l, ws);
-    ws.prev_level = l;
+  sync();  // (1) shared storage sized
+  if (n <= 0) {
+    sync();
+    sync();
+    return stats;
+  }
+  // Phase A: sections of every count-th level; for the cells they reach, whether the cell
+  // starts equal to the one below (read only: nothing changes before phase C).
+  for (int l = lb + index; l < le; l += count) {
+    LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
+    build_level(l, ws, ls, stats);
+    ls.same_cell_below.assign(nreg, 0);
+    if (!spec_.vertical_coherence || l == lb || ls.empty()) continue;
+    for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
+      for (int ix = ls.ix0; ix <= ls.ix1; ++ix) {
+        const int region = iy * spec_.regions_x + ix;
+        ls.same_cell_below[static_cast<std::size_t>(region)] = same_polygons(cell(region, l), cell(region, l - 1)) ? 1 : 0;
+      }
+  }
+  sync();  // (2) sections of all levels built
+  // Phase B, within this thread: which levels have the sections of the level below, and
+  // from there the level each cell takes its result from. Every thread derives the same
+  // table, so the jobs can be dealt without another barrier.
+  ws.source.assign(static_cast<std::size_t>(n) * nreg, -1);
+  for (int l = lb; l < le; ++l) {
+    LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
+    if (ls.empty()) continue;
+    bool same = false;
+    if (spec_.vertical_coherence && l > lb) {
+      const LevelSections& lo = sh.levels[static_cast<std::size_t>(l - 1 - lb)];
+      same = !lo.empty() && ls.chain_r == lo.chain_r && ls.paths == lo.paths;
+    }
+    for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
+      for (int ix = ls.ix0; ix <= ls.ix1; ++ix) {
+        const std::size_t region = static_cast<std::size_t>(iy * spec_.regions_x + ix);
+        const std::size_t k = static_cast<std::size_t>(l - lb) * nreg + region;
+        const int below = same && ls.same_cell_below[region] != 0 ? ws.source[k - nreg] : -1;
+        ws.source[k] = below >= 0 ? below : l;
+      }
+  }
+  // Phase C: clip the cells that start a run, dealt round robin.
+  std::size_t job = 0;
+  for (int l = lb; l < le; ++l) {
+    const LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
+    if (ls.empty()) continue;
+    for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
+      for (int ix = ls.ix0; ix <= ls.ix1; ++ix) {
+        const int region = iy * spec_.regions_x + ix;
+        const std::size_t k = static_cast<std::size_t>(l - lb) * nreg + static_cast<std::size_t>(region);
+        if (ws.source[k] != l) continue;
+        if (job++ % static_cast<std::size_t>(count) != static_cast<std::size_t>(index)) continue;
+        sh.outcome[k] = clip_cell(region, l, ls, ws, stats) ? 1 : 0;
+      }
+  }
+  sync();  // (3) every run's first cell is final
+  // Phase D: the other cells of each run take its result.
+  std::size_t copy = 0;
+  for (int l = lb; l < le; ++l) {
+    const LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
+    if (ls.empty()) continue;
+    for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
+      for (int ix = ls.ix0; ix <= ls.ix1; ++ix) {
+        const int region = iy * spec_.regions_x + ix;
+        const std::size_t k = static_cast<std::size_t>(l - lb) * nreg + static_cast<std::size_t>(region);
+        const int src = ws.source[k];
+        if (src == l) continue;
+        if (copy++ % static_cast<std::size_t>(count) != static_cast<std::size_t>(index)) continue;
+        ++stats.cells_reused;
+        if (sh.outcome[static_cast<std::size_t>(src - lb) * nreg + static_cast<std::size_t>(region)] == 0) continue;
+        const std::size_t ci = static_cast<std::size_t>(region) * levels_ + l;
+        const Cell& from = cells_[static_cast<std::size_t>(region) * levels_ + src];
+        Cell& to = cells_[ci];
+        to.polys = from.polys;
+        to.bbox = from.bbox;
+        to.area_units2 = from.area_units2;
+        to.last_cut = from.last_cut;
+        ++to.version;
+        dirty_flag_[ci] = 1;
+        ++stats.cells_changed;
+      }
   }
   return stats;
+}
+
+// Offsets chain `chain` to radius r (cached per workspace; -1: leave it).
+void LbrSolid::set_chain_radius(SubtractWorkspace& ws, std::uint32_t chain, double r) const {
+  SubtractWorkspace::Chain& c = ws.chains[chain];
+  if (r == c.cached_r || r <= 0.0) return;
+  // Offset vertices lie on radius r + tol/4 and chords sag at most tol/2 inside it, so the
+  // boundary stays within ±tol/4 of the exact one.
+  const double tol = c.shape->chord_tol_mm;
+  ClipperLib::ClipperOffset off(2.0, 0.5 * tol * kUnitsPerMm);
+  off.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
+  c.cached.clear();
+  off.Execute(c.cached, (r + 0.25 * tol) * kUnitsPerMm);
+  c.cached_r = r;
+  c.region_ok.assign(static_cast<std::size_t>(regions()), 0);
 }
 
 // The offset of a chain cut to a region's rectangle grown by 1 mm (so that no cut edge lies on
 // the region's material), computed on first use for each radius. Within a region the clip
 // then carries only the chain's nearby edges instead of the whole offset.
-const Paths& LbrSolid::chain_region_paths(SubtractWorkspace& ws, std::uint32_t chain, int region) {
+const Paths& LbrSolid::chain_region_paths(SubtractWorkspace& ws, std::uint32_t chain, int region) const {
   SubtractWorkspace::Chain& c = ws.chains[chain];
   const std::size_t r = static_cast<std::size_t>(region);
   if (c.region_paths.size() < c.region_ok.size()) c.region_paths.resize(c.region_ok.size());
@@ -420,68 +520,61 @@ const Paths& LbrSolid::chain_region_paths(SubtractWorkspace& ws, std::uint32_t c
   return out;
 }
 
-SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
-  SubtractStats stats;
+void LbrSolid::build_level(int level, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const {
   const double zc = level_z_mm(level);
-  ws.sections.clear();
-  ws.section_box.clear();
-  ws.section_id.clear();
-  ws.section_chain.clear();
-  Rect all;
+  ls.paths.clear();
+  ls.box.clear();
+  ls.id.clear();
+  ls.chain.clear();
+  ls.chain_r.assign(ws.chain_count, -1.0);
+  ls.all = Rect{};
+  ls.ix0 = ls.iy0 = 0;
+  ls.ix1 = ls.iy1 = -1;
   ws.prev_core = Capsule{};
   for (std::size_t si = 0; si < ws.sweeps.size(); ++si) {
     const Sweep& sw = ws.sweeps[si];
     if (zc < sw.z_min() || zc > sw.z_max()) continue;
-    const std::size_t before = ws.sections.size();
-    sw.section(zc, ws.sections, ws.scratch);
+    const std::size_t before = ls.paths.size();
+    sw.section(zc, ls.paths, ws.scratch);
     // Consecutive moves overlap: the vertices of this section inside the previous vertical
     // section's capsule add edges to the clip but remove nothing more (trim_covered()).
-    if (sw.vertical() && ws.sections.size() == before + 1) {
+    if (sw.vertical() && ls.paths.size() == before + 1) {
       if (ws.prev_core.valid()) {
-        const std::size_t vertices = ws.sections.back().size();
-        if (!trim_covered(ws.sections.back(), ws.prev_core, ws.trim_flags)) {
-          ws.sections.pop_back();
+        const std::size_t vertices = ls.paths.back().size();
+        if (!trim_covered(ls.paths.back(), ws.prev_core, ws.trim_flags)) {
+          ls.paths.pop_back();
           ++stats.sections_trimmed;
-        } else if (ws.sections.back().size() != vertices) {
+        } else if (ls.paths.back().size() != vertices) {
           ++stats.sections_trimmed;
         }
       }
       if (ws.scratch.core.valid()) ws.prev_core = ws.scratch.core;
     }
-    for (std::size_t k = before; k < ws.sections.size(); ++k) {
-      ws.section_box.push_back(bounds_of(ws.sections[k]));
-      ws.section_id.push_back(ws.sweep_id[si]);
-      all.add(ws.section_box.back());
+    for (std::size_t k = before; k < ls.paths.size(); ++k) {
+      ls.box.push_back(bounds_of(ls.paths[k]));
+      ls.id.push_back(ws.sweep_id[si]);
+      ls.all.add(ls.box.back());
     }
   }
+  ls.chain.assign(ls.paths.size(), kNoChain);
   for (std::size_t ci = 0; ci < ws.chain_count; ++ci) {
     SubtractWorkspace::Chain& c = ws.chains[ci];
     const double h = zc - c.z;
     if (h < 0.0 || h > c.shape->height()) continue;
     const double r = c.shape->radius_at(h);
     if (r <= 0.0) continue;
-    if (r != c.cached_r) {
-      // Offset vertices lie on radius r + tol/4 and chords sag at most tol/2 inside it, so
-      // the boundary stays within ±tol/4 of the exact one.
-      const double tol = c.shape->chord_tol_mm;
-      ClipperLib::ClipperOffset off(2.0, 0.5 * tol * kUnitsPerMm);
-      off.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
-      c.cached.clear();
-      off.Execute(c.cached, (r + 0.25 * tol) * kUnitsPerMm);
-      c.cached_r = r;
-      c.region_ok.assign(static_cast<std::size_t>(regions()), 0);
-    }
+    set_chain_radius(ws, static_cast<std::uint32_t>(ci), r);
     // One entry for the whole offset (outer contours and holes): its paths are added to a
-    // clip through region_paths(), cut to the region once per radius.
+    // clip through chain_region_paths(), cut to the region once per radius.
     if (c.cached.empty()) continue;
     Rect box;
     for (const Path& p : c.cached) box.add(bounds_of(p));
-    ws.sections.emplace_back();
-    ws.section_box.push_back(box);
-    ws.section_id.push_back(c.id);
-    ws.section_chain.resize(ws.sections.size(), kNoChain);
-    ws.section_chain.back() = static_cast<std::uint32_t>(ci);
-    all.add(box);
+    ls.chain_r[ci] = r;
+    ls.paths.emplace_back();
+    ls.box.push_back(box);
+    ls.id.push_back(c.id);
+    ls.chain.push_back(static_cast<std::uint32_t>(ci));
+    ls.all.add(box);
   }
   // Turning moves: the union of their revolved regions on this level is one region, the
   // smallest r_min (external) and the largest r_max (internal); it takes the latest move id
@@ -505,175 +598,136 @@ SubtractStats LbrSolid::subtract_level(int level, SubtractWorkspace& ws) {
     for (int internal = 0; internal < 2; ++internal) {
       const double r = internal ? r_in : r_out;
       if (!std::isfinite(r)) continue;
-      const std::size_t before = ws.sections.size();
-      LatheSweep::removed_region(r, internal != 0, tol, xy_, ws.sections);
-      for (std::size_t k = before; k < ws.sections.size(); ++k) {
-        ws.section_box.push_back(bounds_of(ws.sections[k]));
-        ws.section_id.push_back(internal ? id_in : id_out);
-        all.add(ws.section_box.back());
+      const std::size_t before = ls.paths.size();
+      LatheSweep::removed_region(r, internal != 0, tol, xy_, ls.paths);
+      for (std::size_t k = before; k < ls.paths.size(); ++k) {
+        ls.box.push_back(bounds_of(ls.paths[k]));
+        ls.id.push_back(internal ? id_in : id_out);
+        ls.chain.push_back(kNoChain);
+        ls.all.add(ls.box.back());
       }
     }
   }
-  ws.section_chain.resize(ws.sections.size(), kNoChain);
-  stats.sections = ws.sections.size();
-  // Same sections as the previous visited level: same paths, same chain radii (the chains'
-  // offsets are cached per radius, so equal radii mean equal offsets).
-  ws.same_sections = false;
-  if (spec_.vertical_coherence) {
-    bool same = ws.prev_level >= 0 && ws.sections == ws.prev_sections && ws.prev_chain_r.size() == ws.chain_count;
-    for (std::size_t ci = 0; same && ci < ws.chain_count; ++ci) {
-      const double h = zc - ws.chains[ci].z;
-      const bool active = h >= 0.0 && h <= ws.chains[ci].shape->height();
-      same = (active ? ws.chains[ci].cached_r : -2.0) == ws.prev_chain_r[ci];
-    }
-    ws.same_sections = same;
-    ws.prev_sections = ws.sections;
-    ws.prev_chain_r.resize(ws.chain_count);
-    for (std::size_t ci = 0; ci < ws.chain_count; ++ci) {
-      const double h = zc - ws.chains[ci].z;
-      const bool active = h >= 0.0 && h <= ws.chains[ci].shape->height();
-      ws.prev_chain_r[ci] = active ? ws.chains[ci].cached_r : -2.0;
-    }
-  }
-  if (ws.sections.empty() || !all.intersects(xy_)) return stats;
+  stats.sections += ls.paths.size();
+  if (ls.paths.empty() || !ls.all.intersects(xy_)) return;
+  ls.ix0 = interval_of(xs_, ls.all.x0);
+  ls.ix1 = interval_of(xs_, ls.all.x1);
+  ls.iy0 = interval_of(ys_, ls.all.y0);
+  ls.iy1 = interval_of(ys_, ls.all.y1);
+}
 
-  const int ix0 = interval_of(xs_, all.x0), ix1 = interval_of(xs_, all.x1);
-  const int iy0 = interval_of(ys_, all.y0), iy1 = interval_of(ys_, all.y1);
-  for (int iy = iy0; iy <= iy1; ++iy) {
-    for (int ix = ix0; ix <= ix1; ++ix) {
-      const int region = iy * spec_.regions_x + ix;
-      const std::size_t ci = static_cast<std::size_t>(region) * levels_ + level;
-      Cell& cell = cells_[ci];
-      if (spec_.vertical_coherence) {
-        // Same start as the previous visited level and same sections: same result. Look
-        // ahead first, while this cell still holds its start.
-        const bool reuse = ws.same_sections && ws.same_below[region] == level;
-        ws.same_below[region] = -1;
-        if (ws.next_level >= 0 && same_polygons(cell, cells_[static_cast<std::size_t>(region) * levels_ + ws.next_level]))
-          ws.same_below[region] = ws.next_level;
-        if (reuse) {
-          ++stats.cells_reused;
-          if (ws.outcome[region] != 0) {
-            const Cell& below = cells_[static_cast<std::size_t>(region) * levels_ + ws.prev_level];
-            cell.polys = below.polys;
-            cell.bbox = below.bbox;
-            cell.area_units2 = below.area_units2;
-            cell.last_cut = below.last_cut;
-            ++cell.version;
-            dirty_flag_[ci] = 1;
-            ++stats.cells_changed;
-          }
-          continue;
-        }
-        ws.outcome[region] = 0;
-      }
-      if (!cell.bbox.intersects(all)) continue;
-      ++stats.cells_tested;
-      ws.selected.clear();
-      Rect clipbox;
-      for (std::uint32_t k = 0; k < ws.sections.size(); ++k) {
-        if (ws.section_box[k].intersects(cell.bbox)) {
-          ws.selected.push_back(k);
-          clipbox.add(ws.section_box[k]);
-        }
-      }
-      if (ws.selected.empty()) continue;
-      ws.touched.clear();
-      for (std::uint32_t p = 0; p < cell.polys.size(); ++p)
-        if (cell.polys[p].bbox.intersects(clipbox)) ws.touched.push_back(p);
-      if (ws.touched.empty()) continue;
-
-      ClipperLib::Clipper& c = ws.clipper;
-      c.Clear();
-      c.StrictlySimple(spec_.strictly_simple);
-      for (std::uint32_t p : ws.touched) {
-        c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
-        for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
-      }
-      for (std::uint32_t k : ws.selected) {
-        if (ws.section_chain[k] == kNoChain) c.AddPath(ws.sections[k], ClipperLib::ptClip, true);
-        else c.AddPaths(chain_region_paths(ws, ws.section_chain[k], region), ClipperLib::ptClip, true);
-      }
-      ws.tree.Clear();
-      c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-      ++stats.cells_clipped;
-      ws.fresh.clear();
-      detail::append_polygons(ws.tree, ws.fresh);
-
-      // A difference that removes no more than the rounding of intersection points to the
-      // unit grid can account for (half a unit along the touched perimeter) is noise, e.g.
-      // a second pass along the same path: keep the old polygons, vertex for vertex.
-      {
-        double before = 0.0, after = 0.0, perimeter = 0.0;
-        for (std::uint32_t p : ws.touched) {
-          const Polygon& old = cell.polys[p];
-          before += ClipperLib::Area(old.outer.pts);
-          perimeter += detail::perimeter(old.outer.pts);
-          for (const Contour& h : old.holes) {
-            before += ClipperLib::Area(h.pts);
-            perimeter += detail::perimeter(h.pts);
-          }
-        }
-        for (const Polygon& poly : ws.fresh) {
-          after += ClipperLib::Area(poly.outer.pts);
-          for (const Contour& h : poly.holes) after += ClipperLib::Area(h.pts);
-        }
-        if (before - after <= 0.5 * perimeter) continue;
-      }
-
-      // Carry the move id over to contours that came out unchanged; a new or changed
-      // contour takes the latest move among the sections that overlap it.
-      bool changed = ws.fresh.size() != ws.touched.size();
-      auto inherit = [&](Contour& out, const Rect& box) {
-        for (std::uint32_t p : ws.touched) {
-          const Polygon& old = cell.polys[p];
-          if (old.bbox == box && detail::same_cycle(old.outer.pts, out.pts)) {
-            out.cut_by = old.outer.cut_by;
-            return;
-          }
-          for (const Contour& h : old.holes) {
-            if (h.pts.size() == out.pts.size() && detail::same_cycle(h.pts, out.pts)) {
-              out.cut_by = h.cut_by;
-              return;
-            }
-          }
-        }
-        changed = true;
-        MoveId id = 0;
-        for (std::uint32_t k : ws.selected)
-          if (ws.section_box[k].intersects(box)) id = std::max(id, ws.section_id[k]);
-        if (id == 0)
-          for (std::uint32_t k : ws.selected) id = std::max(id, ws.section_id[k]);
-        out.cut_by = id;
-      };
-      for (Polygon& poly : ws.fresh) {
-        inherit(poly.outer, poly.bbox);
-        for (Contour& h : poly.holes) inherit(h, bounds_of(h.pts));
-      }
-      if (!changed) continue;
-
-      // Keep the untouched polygons, then append the new ones.
-      ws.kept.clear();
-      std::size_t t = 0;
-      for (std::uint32_t p = 0; p < cell.polys.size(); ++p) {
-        if (t < ws.touched.size() && ws.touched[t] == p) {
-          ++t;
-          continue;
-        }
-        ws.kept.push_back(std::move(cell.polys[p]));
-      }
-      for (Polygon& poly : ws.fresh) ws.kept.push_back(std::move(poly));
-      cell.polys.swap(ws.kept);
-      detail::refresh_cell(cell);
-      cell.last_cut = 0;
-      for (std::uint32_t k : ws.selected) cell.last_cut = std::max(cell.last_cut, ws.section_id[k]);
-      ++cell.version;
-      dirty_flag_[ci] = 1;
-      ++stats.cells_changed;
-      ws.outcome[region] = 1;
+// Clips one cell with the level's sections; true when the cell changed.
+bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, SubtractWorkspace& ws, SubtractStats& stats) {
+  const std::size_t ci = static_cast<std::size_t>(region) * levels_ + level;
+  Cell& cell = cells_[ci];
+  if (!cell.bbox.intersects(ls.all)) return false;
+  ++stats.cells_tested;
+  ws.selected.clear();
+  Rect clipbox;
+  for (std::uint32_t k = 0; k < ls.paths.size(); ++k) {
+    if (ls.box[k].intersects(cell.bbox)) {
+      ws.selected.push_back(k);
+      clipbox.add(ls.box[k]);
     }
   }
-  return stats;
+  if (ws.selected.empty()) return false;
+  ws.touched.clear();
+  for (std::uint32_t p = 0; p < cell.polys.size(); ++p)
+    if (cell.polys[p].bbox.intersects(clipbox)) ws.touched.push_back(p);
+  if (ws.touched.empty()) return false;
+
+  ClipperLib::Clipper& c = ws.clipper;
+  c.Clear();
+  c.StrictlySimple(spec_.strictly_simple);
+  for (std::uint32_t p : ws.touched) {
+    c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
+    for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
+  }
+  for (std::uint32_t k : ws.selected) {
+    if (ls.chain[k] == kNoChain) {
+      c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
+    } else {
+      set_chain_radius(ws, ls.chain[k], ls.chain_r[ls.chain[k]]);
+      c.AddPaths(chain_region_paths(ws, ls.chain[k], region), ClipperLib::ptClip, true);
+    }
+  }
+  ws.tree.Clear();
+  c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  ++stats.cells_clipped;
+  ws.fresh.clear();
+  detail::append_polygons(ws.tree, ws.fresh);
+
+  // A difference that removes no more than the rounding of intersection points to the
+  // unit grid can account for (half a unit along the touched perimeter) is noise, e.g.
+  // a second pass along the same path: keep the old polygons, vertex for vertex.
+  {
+    double before = 0.0, after = 0.0, perimeter = 0.0;
+    for (std::uint32_t p : ws.touched) {
+      const Polygon& old = cell.polys[p];
+      before += ClipperLib::Area(old.outer.pts);
+      perimeter += detail::perimeter(old.outer.pts);
+      for (const Contour& h : old.holes) {
+        before += ClipperLib::Area(h.pts);
+        perimeter += detail::perimeter(h.pts);
+      }
+    }
+    for (const Polygon& poly : ws.fresh) {
+      after += ClipperLib::Area(poly.outer.pts);
+      for (const Contour& h : poly.holes) after += ClipperLib::Area(h.pts);
+    }
+    if (before - after <= 0.5 * perimeter) return false;
+  }
+
+  // Carry the move id over to contours that came out unchanged; a new or changed
+  // contour takes the latest move among the sections that overlap it.
+  bool changed = ws.fresh.size() != ws.touched.size();
+  auto inherit = [&](Contour& out, const Rect& box) {
+    for (std::uint32_t p : ws.touched) {
+      const Polygon& old = cell.polys[p];
+      if (old.bbox == box && detail::same_cycle(old.outer.pts, out.pts)) {
+        out.cut_by = old.outer.cut_by;
+        return;
+      }
+      for (const Contour& h : old.holes) {
+        if (h.pts.size() == out.pts.size() && detail::same_cycle(h.pts, out.pts)) {
+          out.cut_by = h.cut_by;
+          return;
+        }
+      }
+    }
+    changed = true;
+    MoveId id = 0;
+    for (std::uint32_t k : ws.selected)
+      if (ls.box[k].intersects(box)) id = std::max(id, ls.id[k]);
+    if (id == 0)
+      for (std::uint32_t k : ws.selected) id = std::max(id, ls.id[k]);
+    out.cut_by = id;
+  };
+  for (Polygon& poly : ws.fresh) {
+    inherit(poly.outer, poly.bbox);
+    for (Contour& h : poly.holes) inherit(h, bounds_of(h.pts));
+  }
+  if (!changed) return false;
+
+  // Keep the untouched polygons, then append the new ones.
+  ws.kept.clear();
+  std::size_t t = 0;
+  for (std::uint32_t p = 0; p < cell.polys.size(); ++p) {
+    if (t < ws.touched.size() && ws.touched[t] == p) {
+      ++t;
+      continue;
+    }
+    ws.kept.push_back(std::move(cell.polys[p]));
+  }
+  for (Polygon& poly : ws.fresh) ws.kept.push_back(std::move(poly));
+  cell.polys.swap(ws.kept);
+  detail::refresh_cell(cell);
+  cell.last_cut = 0;
+  for (std::uint32_t k : ws.selected) cell.last_cut = std::max(cell.last_cut, ls.id[k]);
+  ++cell.version;
+  dirty_flag_[ci] = 1;
+  ++stats.cells_changed;
+  return true;
 }
 
 SubtractStats LbrSolid::subtract_solid(const LbrSolid& other, MoveId id) {

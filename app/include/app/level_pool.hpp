@@ -1,11 +1,19 @@
 // app/level_pool.hpp — batch-mode worker pool: one subtract() spread over threads by level.
 //
-// Levels are independent in the LBR, so each worker takes every n-th level of the batch
-// (interleaved for balance) with its own SubtractWorkspace. The calling thread is worker 0.
+// Levels are independent in the LBR: the threads run LbrSolid::subtract_shared() together,
+// each with its own SubtractWorkspace (levels' sections, then the clips, dealt round robin;
+// runs of equal levels are clipped once). The calling thread is worker 0.
 // Used by the offline runner only; the live geometry thread subtracts on its own.
+//
+// A batch takes well under a millisecond once the kernel is fast (low: ~0.2 ms), so the
+// hand-over must cost microseconds: workers and the caller spin on atomics for a short while
+// (kSpin) before they block on the condition variables, which are only signalled when
+// someone actually sleeps.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -31,16 +39,24 @@ class LevelPool {
  private:
   void worker(int index);
 
+  void barrier() noexcept;  // spinning barrier over all threads (then yields)
+
   std::vector<std::unique_ptr<geom::SubtractWorkspace>> workspaces_;
+  geom::SubtractShared shared_;
+  std::function<void()> sync_;
+  std::atomic<int> arrived_{0};
+  std::atomic<unsigned> phase_{0};
   std::vector<geom::SubtractStats> results_;
   std::vector<std::thread> threads_;
   std::mutex m_;
   std::condition_variable start_, done_;
-  geom::LbrSolid* solid_ = nullptr;
+  geom::LbrSolid* solid_ = nullptr;            // published by generation_ (release/acquire)
   std::span<const geom::SweepRef> batch_;
-  unsigned long generation_ = 0;
-  int pending_ = 0;
-  bool stop_ = false;
+  std::atomic<unsigned long> generation_{0};
+  std::atomic<int> pending_{0};
+  std::atomic<bool> stop_{false};
+  int sleepers_ = 0;          // workers blocked on start_ (guarded by m_)
+  bool caller_waiting_ = false;  // the caller blocked on done_ (guarded by m_)
 };
 
 }  // namespace lbr::app

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -92,6 +93,28 @@ struct SubtractStats {
   }
 };
 
+// The sections of one level for one batch, built by one thread and read by all.
+struct LevelSections {
+  Paths paths;                        // convex sections, lathe regions; empty for a chain
+  std::vector<Rect> box;              // bounding boxes
+  std::vector<MoveId> id;             // move ids
+  std::vector<std::uint32_t> chain;   // chain index of a chain's entry, else ~0
+  std::vector<double> chain_r;        // per chain: its radius on this level, -1 if none
+  Rect all;                           // union of the boxes
+  int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // regions that the boxes reach
+  bool same_as_below = false;         // equal to the level below's sections
+  std::vector<std::uint8_t> same_cell_below;  // per region: same start as the level below
+  [[nodiscard]] bool empty() const noexcept { return ix1 < ix0 || iy1 < iy0; }
+};
+
+// State that the threads of one subtract_shared() call share: written in one phase, read
+// in the next (the caller's barrier orders them).
+struct SubtractShared {
+  int lb = 0, le = 0;                   // the levels the batch reaches
+  std::vector<LevelSections> levels;    // [le - lb), reused between batches
+  std::vector<std::uint8_t> outcome;    // per (level - lb, region): the clip changed the cell
+};
+
 // Reusable buffers for subtract(); one per thread that calls it. Grows to the largest batch
 // seen and is then reused without further allocation of its own.
 struct SubtractWorkspace {
@@ -119,21 +142,10 @@ struct SubtractWorkspace {
   };
   std::vector<Chain> chains;
   std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
-  Paths sections;                 // section polygons of the current level
   Capsule prev_core;                     // inside the last vertical section (trim_covered())
   std::vector<std::uint8_t> trim_flags;
-  std::vector<Rect> section_box;  // their bounding boxes
-  std::vector<MoveId> section_id; // their move ids
-  std::vector<std::uint32_t> section_chain;  // chain index for a chain's entry, else ~0
-  // Vertical coherence (SolidSpec::vertical_coherence), for the levels one call visits in
-  // order (level, level + stride, ...):
-  Paths prev_sections;              // the previous visited level's sections
-  std::vector<double> prev_chain_r; // and its chains' radii
-  int prev_level = -1;              // that level (-1: none)
-  int next_level = -1;              // the level visited after the current one (-1: none)
-  bool same_sections = false;       // this level's sections equal prev_level's
-  std::vector<int> same_below;      // per region: the level whose start equals prev's start
-  std::vector<std::uint8_t> outcome;  // per region: prev_level's cell changed
+  std::vector<int> source;          // per (level - lb, region): the level whose result it takes
+  SubtractShared own;               // for subtract() on one thread
   std::vector<std::uint32_t> selected, touched;
   std::vector<Polygon> fresh, kept;
 };
@@ -154,12 +166,16 @@ class LbrSolid {
   // dirty. Does not throw; allocates (Clipper does).
   SubtractStats subtract(std::span<const SweepRef> batch);
   SubtractStats subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws);
-  // Same, for the levels [level_begin, level_end) only. Levels are independent, so callers
-  // may run disjoint level ranges on several threads, each with its own workspace.
-  // `stride` > 1 takes every stride-th level from level_begin (interleaving balances the
-  // load when threads share one batch).
-  SubtractStats subtract_levels(std::span<const SweepRef> batch, int level_begin, int level_end,
-                                SubtractWorkspace& ws, int stride = 1);
+  // The same subtraction run by `count` threads together: each calls it with its own
+  // workspace and its index in [0, count), the same batch and the same `shared`; `sync` is a
+  // barrier over the `count` callers (called three times). Each returns its share of the
+  // statistics. Phases: every thread prepares the batch (merging, sweeps, chains); the
+  // levels' sections are built (levels dealt round robin) and compared with the level
+  // below; then the cells that start a run of equal levels are clipped (dealt round robin),
+  // and the rest of each run copies its result (vertical coherence). The result does not
+  // depend on `count`.
+  SubtractStats subtract_shared(std::span<const SweepRef> batch, SubtractShared& shared, SubtractWorkspace& ws,
+                                int index, int count, const std::function<void()>& sync);
 
   // 3D boolean difference with another LBR solid (the paper's OpBool): every level of this
   // solid loses the polygons of the other solid's level that contains the same mid-plane
@@ -216,8 +232,12 @@ class LbrSolid {
 
  private:
   void init_cells();
-  SubtractStats subtract_level(int level, SubtractWorkspace& ws);
-  const Paths& chain_region_paths(SubtractWorkspace& ws, std::uint32_t chain, int region);
+  // Phases of subtract_shared().
+  double prepare(std::span<const SweepRef> batch, SubtractWorkspace& ws, double& zhi) const;
+  void build_level(int level, SubtractWorkspace& ws, LevelSections& out, SubtractStats& stats) const;
+  bool clip_cell(int region, int level, const LevelSections& ls, SubtractWorkspace& ws, SubtractStats& stats);
+  void set_chain_radius(SubtractWorkspace& ws, std::uint32_t chain, double r) const;
+  const Paths& chain_region_paths(SubtractWorkspace& ws, std::uint32_t chain, int region) const;
 
   SolidSpec spec_;
   int levels_ = 0;
