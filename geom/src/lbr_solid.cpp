@@ -522,6 +522,7 @@ const Paths& LbrSolid::chain_region_paths(SubtractWorkspace& ws, std::uint32_t c
 
 void LbrSolid::build_level(int level, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const {
   const double zc = level_z_mm(level);
+  for (Path& p : ls.paths) ws.scratch.spare.push_back(std::move(p));  // keep the buffers
   ls.paths.clear();
   ls.box.clear();
   ls.id.clear();

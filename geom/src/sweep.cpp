@@ -55,17 +55,26 @@ void convex_hull(std::vector<P2>& pts, std::vector<P2>& hull) {
   hull.resize(k - 1);
 }
 
-// Rounds a hull to kernel units and appends it when it still encloses area.
-std::size_t emit(const std::vector<P2>& hull, Paths& out) {
+// Rounds a hull to kernel units and appends it when it still encloses area. The path's
+// buffer comes from `spare` when it has one (no allocation once the pool has grown).
+std::size_t emit(const std::vector<P2>& hull, Paths& out, std::vector<Path>& spare) {
   if (hull.size() < 3) return 0;
   Path p;
+  if (!spare.empty()) {
+    p = std::move(spare.back());
+    spare.pop_back();
+    p.clear();
+  }
   p.reserve(hull.size());
   for (const P2& q : hull) {
     const Point ip{to_units(q.x), to_units(q.y)};
     if (p.empty() || ip.X != p.back().X || ip.Y != p.back().Y) p.push_back(ip);
   }
   while (p.size() > 1 && p.front().X == p.back().X && p.front().Y == p.back().Y) p.pop_back();
-  if (p.size() < 3) return 0;
+  if (p.size() < 3) {
+    spare.push_back(std::move(p));
+    return 0;
+  }
   out.push_back(std::move(p));
   return 1;
 }
@@ -280,7 +289,7 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
         if (k == k_right) break;
       }
     }
-    return emit(sc.hull, out);
+    return emit(sc.hull, out, sc.spare);
   }
   ramp_hull(sc, n, grow, uc);
   // Capsule: the disk farthest along the motion and the largest one (or the first).
@@ -294,7 +303,7 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
     const double c = std::cos(std::numbers::pi / n);
     sc.core = Capsule{ds[other].x, ds[other].y, ds[other].r * c, ds[last].x, ds[last].y, ds[last].r * c};
   }
-  return emit(sc.hull, out);
+  return emit(sc.hull, out, sc.spare);
 }
 
 // Hull of several n-gons on one angle grid whose centres lie on the line of motion (a ramp),
@@ -517,7 +526,7 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) co
       }
     }
     convex_hull(sc.pts, sc.hull);
-    emitted += emit(sc.hull, out);
+    emitted += emit(sc.hull, out, sc.spare);
   }
   return emitted;
 }

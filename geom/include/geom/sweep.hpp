@@ -52,6 +52,8 @@ struct SectionScratch {
   // Set by each vertical section: a capsule inside the polygon just emitted (invalid when
   // the last section was empty or came from the general path).
   Capsule core;
+  // Emptied paths whose buffers section() reuses (callers may give theirs back).
+  std::vector<Path> spare;
   // Unit circle with n vertices, (cos, sin) pairs, built on first use of each n.
   [[nodiscard]] const std::vector<P2>& unit_circle(int n);
 
