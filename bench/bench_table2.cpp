@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
       app::apply_regions(prof, g, "--grids");
       const app::BatchResult r = app::run_batch(prof, path);
       const double factor = r.wall_time_s / machining;
-      std::fprintf(f, "%s,%s,%d,%.2f,%.3f,%.5f,%.3f,%zu,%.1f\n", w.c_str(), g.c_str(), r.solid.regions(), machining,
+      std::fprintf(f, "%s,%s,%d,%.2f,%.4f,%.5f,%.3f,%zu,%.1f\n", w.c_str(), g.c_str(), r.solid.regions(), machining,
                    r.wall_time_s, factor, r.removed_volume_mm3, r.solid.vertex_count(), app::peak_rss_mb());
       std::fflush(f);
       std::printf("%-7s %-6s (%3dx%-3d) machining %7.2f s  simulated %8.3f s  factor %.5f  removed %.1f mm3\n", w.c_str(),

@@ -354,7 +354,6 @@ double LbrSolid::prepare(std::span<const SweepRef> batch, SubtractWorkspace& ws,
           c.pts.push_back({to_units(ws.merged[k].to.tip.x), to_units(ws.merged[k].to.tip.y)});
           c.id = std::max(c.id, ws.merged[k].id);
         }
-        c.cached_r = -1.0;
         zlo = std::min(zlo, c.z);
         zhi = std::max(zhi, c.z + s.shape->height());
         i = j - 1;
@@ -387,23 +386,95 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
   const int le = nothing ? 0 : level_at(zhi) + 1;
   const int n = le - lb;
   const std::size_t nreg = static_cast<std::size_t>(regions());
+  // The distinct (chain, radius) pairs of the batch, in level order (the same in every
+  // thread): a flat tool's chain has one radius on all its levels.
+  const std::size_t cc = ws.chain_count;
+  ws.offset_keys.clear();
+  ws.offset_of.assign(static_cast<std::size_t>(std::max(n, 0)) * cc, kNoChain);
+  for (int l = lb; l < le; ++l) {
+    const double zc = level_z_mm(l);
+    for (std::size_t ci = 0; ci < cc; ++ci) {
+      const SubtractWorkspace::Chain& c = ws.chains[ci];
+      const double h = zc - c.z;
+      if (h < 0.0 || h > c.shape->height()) continue;
+      const double r = c.shape->radius_at(h);
+      if (r <= 0.0) continue;
+      std::uint32_t o = kNoChain;
+      for (std::size_t k = ws.offset_keys.size(); k-- > 0;)
+        if (ws.offset_keys[k].chain == ci && ws.offset_keys[k].r == r) {
+          o = static_cast<std::uint32_t>(k);
+          break;
+        }
+      if (o == kNoChain) {
+        o = static_cast<std::uint32_t>(ws.offset_keys.size());
+        ws.offset_keys.push_back({static_cast<std::uint32_t>(ci), r});
+      }
+      ws.offset_of[static_cast<std::size_t>(l - lb) * cc + ci] = o;
+    }
+  }
+  const std::size_t noff = ws.offset_keys.size();
   if (index == 0) {
     sh.lb = lb;
     sh.le = le;
     if (sh.levels.size() < static_cast<std::size_t>(n)) sh.levels.resize(static_cast<std::size_t>(n));
-    sh.outcome.assign(static_cast<std::size_t>(n) * nreg, 0);
+    sh.outcome.assign(static_cast<std::size_t>(std::max(n, 0)) * nreg, 0);
+    if (sh.offsets.size() < noff) sh.offsets.resize(noff);
   }
   sync();  // (1) shared storage sized
   if (n <= 0) {
-    sync();
-    sync();
+    for (int i = 0; i < 4; ++i) sync();
     return stats;
   }
+  // Chain offsets, dealt round robin. Offset vertices lie on radius r + tol/4 and chords
+  // sag at most tol/2 inside it, so the boundary stays within ±tol/4 of the exact one.
+  for (std::size_t o = static_cast<std::size_t>(index); o < noff; o += static_cast<std::size_t>(count)) {
+    const SubtractWorkspace::Chain& c = ws.chains[ws.offset_keys[o].chain];
+    SubtractShared::Offset& off = sh.offsets[o];
+    const double tol = c.shape->chord_tol_mm;
+    ClipperLib::ClipperOffset co(2.0, 0.5 * tol * kUnitsPerMm);
+    co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
+    off.paths.clear();
+    co.Execute(off.paths, (ws.offset_keys[o].r + 0.25 * tol) * kUnitsPerMm);
+    off.box = Rect{};
+    for (const Path& p : off.paths) off.box.add(bounds_of(p));
+    off.ix0 = interval_of(xs_, off.box.x0);
+    off.ix1 = interval_of(xs_, off.box.x1);
+    off.iy0 = interval_of(ys_, off.box.y0);
+    off.iy1 = interval_of(ys_, off.box.y1);
+    if (off.paths.empty()) off.ix1 = off.ix0 - 1;
+    off.cut.resize(static_cast<std::size_t>(std::max(0, (off.ix1 - off.ix0 + 1) * (off.iy1 - off.iy0 + 1))));
+  }
+  sync();  // (2) offsets ready
   // Phase A: sections of every count-th level; for the cells they reach, whether the cell
-  // starts equal to the one below (read only: nothing changes before phase C).
+  // starts equal to the one below (read only: nothing changes before phase C). Also the
+  // offsets' region pieces, dealt round robin.
+  {
+    std::size_t job = 0;
+    for (std::size_t o = 0; o < noff; ++o) {
+      SubtractShared::Offset& off = sh.offsets[o];
+      for (int iy = off.iy0; iy <= off.iy1; ++iy)
+        for (int ix = off.ix0; ix <= off.ix1; ++ix) {
+          if (job++ % static_cast<std::size_t>(count) != static_cast<std::size_t>(index)) continue;
+          Paths& out = off.cut[static_cast<std::size_t>((iy - off.iy0) * (off.ix1 - off.ix0 + 1) + (ix - off.ix0))];
+          out.clear();
+          Rect rr = region_rect(iy * spec_.regions_x + ix);
+          const Coord grow = static_cast<Coord>(kUnitsPerMm);
+          rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
+          if (off.box.x0 >= rr.x0 && off.box.x1 <= rr.x1 && off.box.y0 >= rr.y0 && off.box.y1 <= rr.y1) {
+            out = off.paths;  // wholly inside: nothing to cut
+            continue;
+          }
+          ClipperLib::Clipper& k = ws.rect_clipper;
+          k.Clear();
+          k.AddPaths(off.paths, ClipperLib::ptSubject, true);
+          k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
+          k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+        }
+    }
+  }
   for (int l = lb + index; l < le; l += count) {
     LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
-    build_level(l, ws, ls, stats);
+    build_level(l, lb, sh, ws, ls, stats);
     ls.same_cell_below.assign(nreg, 0);
     if (!spec_.vertical_coherence || l == lb || ls.empty()) continue;
     for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
@@ -412,19 +483,23 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
         ls.same_cell_below[static_cast<std::size_t>(region)] = same_polygons(cell(region, l), cell(region, l - 1)) ? 1 : 0;
       }
   }
-  sync();  // (2) sections of all levels built
-  // Phase B, within this thread: which levels have the sections of the level below, and
-  // from there the level each cell takes its result from. Every thread derives the same
-  // table, so the jobs can be dealt without another barrier.
+  sync();  // (3) sections of all levels built
+  // Which levels have the sections of the level below (same dealing as phase A).
+  for (int l = lb + index; l < le; l += count) {
+    LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
+    ls.same_as_below = false;
+    if (!spec_.vertical_coherence || l == lb || ls.empty()) continue;
+    const LevelSections& lo = sh.levels[static_cast<std::size_t>(l - 1 - lb)];
+    ls.same_as_below = !lo.empty() && ls.chain_offset == lo.chain_offset && ls.paths == lo.paths;
+  }
+  sync();  // (4)
+  // Phase B, within this thread: the level each cell takes its result from. Every thread
+  // derives the same table, so the jobs can be dealt without another barrier.
   ws.source.assign(static_cast<std::size_t>(n) * nreg, -1);
   for (int l = lb; l < le; ++l) {
     LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
     if (ls.empty()) continue;
-    bool same = false;
-    if (spec_.vertical_coherence && l > lb) {
-      const LevelSections& lo = sh.levels[static_cast<std::size_t>(l - 1 - lb)];
-      same = !lo.empty() && ls.chain_r == lo.chain_r && ls.paths == lo.paths;
-    }
+    const bool same = ls.same_as_below;
     for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
       for (int ix = ls.ix0; ix <= ls.ix1; ++ix) {
         const std::size_t region = static_cast<std::size_t>(iy * spec_.regions_x + ix);
@@ -444,10 +519,10 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
         const std::size_t k = static_cast<std::size_t>(l - lb) * nreg + static_cast<std::size_t>(region);
         if (ws.source[k] != l) continue;
         if (job++ % static_cast<std::size_t>(count) != static_cast<std::size_t>(index)) continue;
-        sh.outcome[k] = clip_cell(region, l, ls, ws, stats) ? 1 : 0;
+        sh.outcome[k] = clip_cell(region, l, ls, sh, ws, stats) ? 1 : 0;
       }
   }
-  sync();  // (3) every run's first cell is final
+  sync();  // (5) every run's first cell is final
   // Phase D: the other cells of each run take its result.
   std::size_t copy = 0;
   for (int l = lb; l < le; ++l) {
@@ -477,57 +552,15 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
   return stats;
 }
 
-// Offsets chain `chain` to radius r (cached per workspace; -1: leave it).
-void LbrSolid::set_chain_radius(SubtractWorkspace& ws, std::uint32_t chain, double r) const {
-  SubtractWorkspace::Chain& c = ws.chains[chain];
-  if (r == c.cached_r || r <= 0.0) return;
-  // Offset vertices lie on radius r + tol/4 and chords sag at most tol/2 inside it, so the
-  // boundary stays within ±tol/4 of the exact one.
-  const double tol = c.shape->chord_tol_mm;
-  ClipperLib::ClipperOffset off(2.0, 0.5 * tol * kUnitsPerMm);
-  off.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
-  c.cached.clear();
-  off.Execute(c.cached, (r + 0.25 * tol) * kUnitsPerMm);
-  c.cached_r = r;
-  c.region_ok.assign(static_cast<std::size_t>(regions()), 0);
-}
-
-// The offset of a chain cut to a region's rectangle grown by 1 mm (so that no cut edge lies on
-// the region's material), computed on first use for each radius. Within a region the clip
-// then carries only the chain's nearby edges instead of the whole offset.
-const Paths& LbrSolid::chain_region_paths(SubtractWorkspace& ws, std::uint32_t chain, int region) const {
-  SubtractWorkspace::Chain& c = ws.chains[chain];
-  const std::size_t r = static_cast<std::size_t>(region);
-  if (c.region_paths.size() < c.region_ok.size()) c.region_paths.resize(c.region_ok.size());
-  if (c.region_ok[r] != 0) return c.region_paths[r];
-  Rect rr = region_rect(region);
-  const Coord grow = static_cast<Coord>(kUnitsPerMm);
-  rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
-  Paths& out = c.region_paths[r];
-  out.clear();
-  Rect whole;
-  for (const Path& p : c.cached) whole.add(bounds_of(p));
-  if (whole.x0 >= rr.x0 && whole.x1 <= rr.x1 && whole.y0 >= rr.y0 && whole.y1 <= rr.y1) {
-    out = c.cached;  // wholly inside: nothing to cut
-  } else {
-    ClipperLib::Clipper& k = ws.rect_clipper;  // ws.clipper is being filled by the caller
-    k.Clear();
-    k.AddPaths(c.cached, ClipperLib::ptSubject, true);
-    k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
-    k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-  }
-  c.region_ok[r] = 1;
-  return out;
-}
-
-void LbrSolid::build_level(int level, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const {
+void LbrSolid::build_level(int level, int lb, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
+                           SubtractStats& stats) const {
   const double zc = level_z_mm(level);
   for (Path& p : ls.paths) ws.scratch.spare.push_back(std::move(p));  // keep the buffers
   ls.paths.clear();
   ls.box.clear();
   ls.id.clear();
   ls.chain.clear();
-  ls.chain_r.assign(ws.chain_count, -1.0);
+  ls.chain_offset.assign(ws.chain_count, kNoChain);
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
@@ -558,24 +591,17 @@ void LbrSolid::build_level(int level, SubtractWorkspace& ws, LevelSections& ls, 
     }
   }
   ls.chain.assign(ls.paths.size(), kNoChain);
+  // Chains: one entry for the whole offset (outer contours and holes); a clip adds its
+  // piece cut to the region (SubtractShared::Offset).
   for (std::size_t ci = 0; ci < ws.chain_count; ++ci) {
-    SubtractWorkspace::Chain& c = ws.chains[ci];
-    const double h = zc - c.z;
-    if (h < 0.0 || h > c.shape->height()) continue;
-    const double r = c.shape->radius_at(h);
-    if (r <= 0.0) continue;
-    set_chain_radius(ws, static_cast<std::uint32_t>(ci), r);
-    // One entry for the whole offset (outer contours and holes): its paths are added to a
-    // clip through chain_region_paths(), cut to the region once per radius.
-    if (c.cached.empty()) continue;
-    Rect box;
-    for (const Path& p : c.cached) box.add(bounds_of(p));
-    ls.chain_r[ci] = r;
+    const std::uint32_t o = ws.offset_of[static_cast<std::size_t>(level - lb) * ws.chain_count + ci];
+    if (o == kNoChain || sh.offsets[o].paths.empty()) continue;
+    ls.chain_offset[ci] = o;
     ls.paths.emplace_back();
-    ls.box.push_back(box);
-    ls.id.push_back(c.id);
-    ls.chain.push_back(static_cast<std::uint32_t>(ci));
-    ls.all.add(box);
+    ls.box.push_back(sh.offsets[o].box);
+    ls.id.push_back(ws.chains[ci].id);
+    ls.chain.push_back(o);
+    ls.all.add(sh.offsets[o].box);
   }
   // Turning moves: the union of their revolved regions on this level is one region, the
   // smallest r_min (external) and the largest r_max (internal); it takes the latest move id
@@ -618,7 +644,8 @@ void LbrSolid::build_level(int level, SubtractWorkspace& ws, LevelSections& ls, 
 }
 
 // Clips one cell with the level's sections; true when the cell changed.
-bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, SubtractWorkspace& ws, SubtractStats& stats) {
+bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, const SubtractShared& sh, SubtractWorkspace& ws,
+                         SubtractStats& stats) {
   const std::size_t ci = static_cast<std::size_t>(region) * levels_ + level;
   Cell& cell = cells_[ci];
   if (!cell.bbox.intersects(ls.all)) return false;
@@ -648,8 +675,8 @@ bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, Subtrac
     if (ls.chain[k] == kNoChain) {
       c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
     } else {
-      set_chain_radius(ws, ls.chain[k], ls.chain_r[ls.chain[k]]);
-      c.AddPaths(chain_region_paths(ws, ls.chain[k], region), ClipperLib::ptClip, true);
+      c.AddPaths(sh.offsets[ls.chain[k]].piece(region % spec_.regions_x, region / spec_.regions_x), ClipperLib::ptClip,
+                 true);
     }
   }
   ws.tree.Clear();

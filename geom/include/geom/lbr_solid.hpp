@@ -98,8 +98,8 @@ struct LevelSections {
   Paths paths;                        // convex sections, lathe regions; empty for a chain
   std::vector<Rect> box;              // bounding boxes
   std::vector<MoveId> id;             // move ids
-  std::vector<std::uint32_t> chain;   // chain index of a chain's entry, else ~0
-  std::vector<double> chain_r;        // per chain: its radius on this level, -1 if none
+  std::vector<std::uint32_t> chain;   // offset index (SubtractShared) of a chain's entry, else ~0
+  std::vector<std::uint32_t> chain_offset;  // per chain: its offset on this level, or ~0
   Rect all;                           // union of the boxes
   int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // regions that the boxes reach
   bool same_as_below = false;         // equal to the level below's sections
@@ -113,6 +113,19 @@ struct SubtractShared {
   int lb = 0, le = 0;                   // the levels the batch reaches
   std::vector<LevelSections> levels;    // [le - lb), reused between batches
   std::vector<std::uint8_t> outcome;    // per (level - lb, region): the clip changed the cell
+  // A chain offset by one radius (one per distinct (chain, radius) of the batch), and its
+  // pieces cut to the regions its box reaches (rectangles grown by 1 mm), so that a clip
+  // carries only the nearby edges.
+  struct Offset {
+    Paths paths;
+    Rect box;
+    int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;
+    std::vector<Paths> cut;  // (iy - iy0) * (ix1 - ix0 + 1) + (ix - ix0)
+    [[nodiscard]] const Paths& piece(int ix, int iy) const {
+      return cut[static_cast<std::size_t>((iy - iy0) * (ix1 - ix0 + 1) + (ix - ix0))];
+    }
+  };
+  std::vector<Offset> offsets;
 };
 
 // Reusable buffers for subtract(); one per thread that calls it. Grows to the largest batch
@@ -135,16 +148,18 @@ struct SubtractWorkspace {
     double z = 0.0;            // tip height [mm]
     Path pts;                  // tip positions [units]
     MoveId id = 0;             // largest move id of the run
-    double cached_r = -1.0;    // radius of `cached` [mm]
-    Paths cached;
-    std::vector<std::uint8_t> region_ok;  // per region: region_paths[r] is `cached` cut to it
-    std::vector<Paths> region_paths;
   };
   std::vector<Chain> chains;
   std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
   Capsule prev_core;                     // inside the last vertical section (trim_covered())
   std::vector<std::uint8_t> trim_flags;
   std::vector<int> source;          // per (level - lb, region): the level whose result it takes
+  struct OffsetKey {
+    std::uint32_t chain;
+    double r;
+  };
+  std::vector<OffsetKey> offset_keys;      // the batch's distinct (chain, radius), in order
+  std::vector<std::uint32_t> offset_of;    // per (level - lb, chain): index into offset_keys, or ~0
   SubtractShared own;               // for subtract() on one thread
   std::vector<std::uint32_t> selected, touched;
   std::vector<Polygon> fresh, kept;
@@ -168,7 +183,7 @@ class LbrSolid {
   SubtractStats subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws);
   // The same subtraction run by `count` threads together: each calls it with its own
   // workspace and its index in [0, count), the same batch and the same `shared`; `sync` is a
-  // barrier over the `count` callers (called three times). Each returns its share of the
+  // barrier over the `count` callers (called five times). Each returns its share of the
   // statistics. Phases: every thread prepares the batch (merging, sweeps, chains); the
   // levels' sections are built (levels dealt round robin) and compared with the level
   // below; then the cells that start a run of equal levels are clipped (dealt round robin),
@@ -234,10 +249,10 @@ class LbrSolid {
   void init_cells();
   // Phases of subtract_shared().
   double prepare(std::span<const SweepRef> batch, SubtractWorkspace& ws, double& zhi) const;
-  void build_level(int level, SubtractWorkspace& ws, LevelSections& out, SubtractStats& stats) const;
-  bool clip_cell(int region, int level, const LevelSections& ls, SubtractWorkspace& ws, SubtractStats& stats);
-  void set_chain_radius(SubtractWorkspace& ws, std::uint32_t chain, double r) const;
-  const Paths& chain_region_paths(SubtractWorkspace& ws, std::uint32_t chain, int region) const;
+  void build_level(int level, int lb, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& out,
+                   SubtractStats& stats) const;
+  bool clip_cell(int region, int level, const LevelSections& ls, const SubtractShared& sh, SubtractWorkspace& ws,
+                 SubtractStats& stats);
 
   SolidSpec spec_;
   int levels_ = 0;
