@@ -413,89 +413,114 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
     }
   }
   const std::size_t noff = ws.offset_keys.size();
+  // Offset boxes from the polyline's box (conservative: the offset lies within r + tol/4 of
+  // it), so that levels can be built while the offsets are being computed.
+  ws.offset_box.resize(noff);
+  for (std::size_t o = 0; o < noff; ++o) {
+    const SubtractWorkspace::Chain& c = ws.chains[ws.offset_keys[o].chain];
+    const Coord d = static_cast<Coord>(std::ceil((ws.offset_keys[o].r + 0.25 * c.shape->chord_tol_mm) * kUnitsPerMm)) + 2;
+    const Rect b = bounds_of(c.pts);
+    ws.offset_box[o] = Rect{b.x0 - d, b.y0 - d, b.x1 + d, b.y1 + d};
+  }
   if (index == 0) {
     sh.lb = lb;
     sh.le = le;
     if (sh.levels.size() < static_cast<std::size_t>(n)) sh.levels.resize(static_cast<std::size_t>(n));
     sh.outcome.assign(static_cast<std::size_t>(std::max(n, 0)) * nreg, 0);
     if (sh.offsets.size() < noff) sh.offsets.resize(noff);
+    for (std::size_t o = 0; o < noff; ++o) {
+      SubtractShared::Offset& off = sh.offsets[o];
+      off.box = ws.offset_box[o];
+      off.ix0 = interval_of(xs_, off.box.x0);
+      off.ix1 = interval_of(xs_, off.box.x1);
+      off.iy0 = interval_of(ys_, off.box.y0);
+      off.iy1 = interval_of(ys_, off.box.y1);
+      off.cut.resize(static_cast<std::size_t>((off.ix1 - off.ix0 + 1) * (off.iy1 - off.iy0 + 1)));
+    }
+    for (auto& next : sh.next) next.store(0, std::memory_order_relaxed);
   }
   sync();  // (1) shared storage sized
   if (n <= 0) {
-    for (int i = 0; i < 4; ++i) sync();
+    for (int i = 0; i < 3; ++i) sync();
     return stats;
   }
-  // Chain offsets, dealt round robin. Offset vertices lie on radius r + tol/4 and chords
-  // sag at most tol/2 inside it, so the boundary stays within ±tol/4 of the exact one.
-  for (std::size_t o = static_cast<std::size_t>(index); o < noff; o += static_cast<std::size_t>(count)) {
-    const SubtractWorkspace::Chain& c = ws.chains[ws.offset_keys[o].chain];
-    SubtractShared::Offset& off = sh.offsets[o];
-    const double tol = c.shape->chord_tol_mm;
-    ClipperLib::ClipperOffset co(2.0, 0.5 * tol * kUnitsPerMm);
-    co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
-    off.paths.clear();
-    co.Execute(off.paths, (ws.offset_keys[o].r + 0.25 * tol) * kUnitsPerMm);
-    off.box = Rect{};
-    for (const Path& p : off.paths) off.box.add(bounds_of(p));
-    off.ix0 = interval_of(xs_, off.box.x0);
-    off.ix1 = interval_of(xs_, off.box.x1);
-    off.iy0 = interval_of(ys_, off.box.y0);
-    off.iy1 = interval_of(ys_, off.box.y1);
-    if (off.paths.empty()) off.ix1 = off.ix0 - 1;
-    off.cut.resize(static_cast<std::size_t>(std::max(0, (off.ix1 - off.ix0 + 1) * (off.iy1 - off.iy0 + 1))));
-  }
-  sync();  // (2) offsets ready
-  // Phase A: sections of every count-th level; for the cells they reach, whether the cell
-  // starts equal to the one below (read only: nothing changes before phase C). Also the
-  // offsets' region pieces, dealt round robin.
-  {
-    std::size_t job = 0;
-    for (std::size_t o = 0; o < noff; ++o) {
-      SubtractShared::Offset& off = sh.offsets[o];
-      for (int iy = off.iy0; iy <= off.iy1; ++iy)
-        for (int ix = off.ix0; ix <= off.ix1; ++ix) {
-          if (job++ % static_cast<std::size_t>(count) != static_cast<std::size_t>(index)) continue;
-          Paths& out = off.cut[static_cast<std::size_t>((iy - off.iy0) * (off.ix1 - off.ix0 + 1) + (ix - off.ix0))];
-          out.clear();
-          Rect rr = region_rect(iy * spec_.regions_x + ix);
-          const Coord grow = static_cast<Coord>(kUnitsPerMm);
-          rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
-          if (off.box.x0 >= rr.x0 && off.box.x1 <= rr.x1 && off.box.y0 >= rr.y0 && off.box.y1 <= rr.y1) {
-            out = off.paths;  // wholly inside: nothing to cut
-            continue;
-          }
-          ClipperLib::Clipper& k = ws.rect_clipper;
-          k.Clear();
-          k.AddPaths(off.paths, ClipperLib::ptSubject, true);
-          k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
-          k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-        }
+  // Work is taken from shared counters, so a thread that gets a long item takes fewer of
+  // the rest; which thread does an item never changes the result.
+  auto take = [&](int phase) { return sh.next[static_cast<std::size_t>(phase)].fetch_add(1, std::memory_order_relaxed); };
+  // Phase A: the chain offsets (items [0, noff)) and the levels' sections (the rest); for
+  // the cells a level reaches, whether the cell starts equal to the one below (read only:
+  // nothing changes before phase C). Offset vertices lie on radius r + tol/4 and chords sag
+  // at most tol/2 inside it, so the boundary stays within ±tol/4 of the exact one.
+  for (std::size_t item = take(0); item < noff + static_cast<std::size_t>(n); item = take(0)) {
+    if (item < noff) {
+      const SubtractWorkspace::Chain& c = ws.chains[ws.offset_keys[item].chain];
+      SubtractShared::Offset& off = sh.offsets[item];
+      const double tol = c.shape->chord_tol_mm;
+      ClipperLib::ClipperOffset co(2.0, 0.5 * tol * kUnitsPerMm);
+      co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
+      off.paths.clear();
+      co.Execute(off.paths, (ws.offset_keys[item].r + 0.25 * tol) * kUnitsPerMm);
+      continue;
     }
-  }
-  for (int l = lb + index; l < le; l += count) {
+    const int l = lb + static_cast<int>(item - noff);
     LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
     build_level(l, lb, sh, ws, ls, stats);
     ls.same_cell_below.assign(nreg, 0);
-    if (!spec_.vertical_coherence || l == lb || ls.empty()) continue;
+    ls.cost.assign(nreg, 0);
     for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
       for (int ix = ls.ix0; ix <= ls.ix1; ++ix) {
         const int region = iy * spec_.regions_x + ix;
-        ls.same_cell_below[static_cast<std::size_t>(region)] = same_polygons(cell(region, l), cell(region, l - 1)) ? 1 : 0;
+        const Cell& c = cell(region, l);
+        std::size_t v = 0;
+        for (const Polygon& p : c.polys) {
+          v += p.outer.pts.size();
+          for (const Contour& h : p.holes) v += h.pts.size();
+        }
+        ls.cost[static_cast<std::size_t>(region)] = static_cast<std::uint32_t>(std::min<std::size_t>(v, 0xFFFFFFFFu));
+        if (spec_.vertical_coherence && l > lb)
+          ls.same_cell_below[static_cast<std::size_t>(region)] = same_polygons(c, cell(region, l - 1)) ? 1 : 0;
       }
   }
-  sync();  // (3) sections of all levels built
-  // Which levels have the sections of the level below (same dealing as phase A).
-  for (int l = lb + index; l < le; l += count) {
+  sync();  // (2) offsets and sections built
+  // Phase A2: the offsets' region pieces (items over every offset's regions), then which
+  // levels have the sections of the level below.
+  std::size_t pieces = 0;
+  for (std::size_t o = 0; o < noff; ++o) pieces += sh.offsets[o].cut.size();
+  for (std::size_t item = take(1); item < pieces + static_cast<std::size_t>(n); item = take(1)) {
+    if (item < pieces) {
+      std::size_t o = 0, i = item;
+      while (i >= sh.offsets[o].cut.size()) i -= sh.offsets[o++].cut.size();
+      SubtractShared::Offset& off = sh.offsets[o];
+      const int w = off.ix1 - off.ix0 + 1;
+      const int ix = off.ix0 + static_cast<int>(i) % w, iy = off.iy0 + static_cast<int>(i) / w;
+      Paths& out = off.cut[i];
+      out.clear();
+      Rect rr = region_rect(iy * spec_.regions_x + ix);
+      const Coord grow = static_cast<Coord>(kUnitsPerMm);
+      rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
+      if (off.box.x0 >= rr.x0 && off.box.x1 <= rr.x1 && off.box.y0 >= rr.y0 && off.box.y1 <= rr.y1) {
+        out = off.paths;  // wholly inside: nothing to cut
+        continue;
+      }
+      ClipperLib::Clipper& k = ws.rect_clipper;
+      k.Clear();
+      k.AddPaths(off.paths, ClipperLib::ptSubject, true);
+      k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
+      k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+      continue;
+    }
+    const int l = lb + static_cast<int>(item - pieces);
     LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
     ls.same_as_below = false;
     if (!spec_.vertical_coherence || l == lb || ls.empty()) continue;
     const LevelSections& lo = sh.levels[static_cast<std::size_t>(l - 1 - lb)];
     ls.same_as_below = !lo.empty() && ls.chain_offset == lo.chain_offset && ls.paths == lo.paths;
   }
-  sync();  // (4)
-  // Phase B, within this thread: the level each cell takes its result from. Every thread
-  // derives the same table, so the jobs can be dealt without another barrier.
+  sync();  // (3)
+  // Phase B, within this thread: the level each cell takes its result from, and the list
+  // of cells that start a run. Every thread derives the same table.
   ws.source.assign(static_cast<std::size_t>(n) * nreg, -1);
+  ws.jobs.clear();
   for (int l = lb; l < le; ++l) {
     LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
     if (ls.empty()) continue;
@@ -506,23 +531,29 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
         const std::size_t k = static_cast<std::size_t>(l - lb) * nreg + region;
         const int below = same && ls.same_cell_below[region] != 0 ? ws.source[k - nreg] : -1;
         ws.source[k] = below >= 0 ? below : l;
+        if (below < 0) ws.jobs.push_back(static_cast<std::uint32_t>(k));
       }
   }
-  // Phase C: clip the cells that start a run, dealt round robin.
-  std::size_t job = 0;
-  for (int l = lb; l < le; ++l) {
-    const LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
-    if (ls.empty()) continue;
-    for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
-      for (int ix = ls.ix0; ix <= ls.ix1; ++ix) {
-        const int region = iy * spec_.regions_x + ix;
-        const std::size_t k = static_cast<std::size_t>(l - lb) * nreg + static_cast<std::size_t>(region);
-        if (ws.source[k] != l) continue;
-        if (job++ % static_cast<std::size_t>(count) != static_cast<std::size_t>(index)) continue;
-        sh.outcome[k] = clip_cell(region, l, ls, sh, ws, stats) ? 1 : 0;
-      }
+  // Phase C: clip the cells that start a run, longest first (estimated by the cell's
+  // vertex count before the batch, from phase A: cells change from here on), so that no
+  // thread is left with a long clip at the end.
+  if (count > 1 && ws.jobs.size() > 1) {
+    ws.job_cost.resize(ws.jobs.size());
+    for (std::size_t j = 0; j < ws.jobs.size(); ++j) {
+      const std::size_t k = ws.jobs[j];
+      ws.job_cost[j] = {sh.levels[k / nreg].cost[k % nreg], ws.jobs[j]};
+    }
+    std::sort(ws.job_cost.begin(), ws.job_cost.end(), [](const auto& a, const auto& b) {
+      return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    for (std::size_t j = 0; j < ws.jobs.size(); ++j) ws.jobs[j] = ws.job_cost[j].second;
   }
-  sync();  // (5) every run's first cell is final
+  for (std::size_t j = take(2); j < ws.jobs.size(); j = take(2)) {
+    const std::size_t k = ws.jobs[j];
+    const int l = lb + static_cast<int>(k / nreg), region = static_cast<int>(k % nreg);
+    sh.outcome[k] = clip_cell(region, l, sh.levels[k / nreg], sh, ws, stats) ? 1 : 0;
+  }
+  sync();  // (4) every run's first cell is final
   // Phase D: the other cells of each run take its result.
   std::size_t copy = 0;
   for (int l = lb; l < le; ++l) {
@@ -595,7 +626,7 @@ void LbrSolid::build_level(int level, int lb, const SubtractShared& sh, Subtract
   // piece cut to the region (SubtractShared::Offset).
   for (std::size_t ci = 0; ci < ws.chain_count; ++ci) {
     const std::uint32_t o = ws.offset_of[static_cast<std::size_t>(level - lb) * ws.chain_count + ci];
-    if (o == kNoChain || sh.offsets[o].paths.empty()) continue;
+    if (o == kNoChain) continue;  // (the offset itself may still be in the making)
     ls.chain_offset[ci] = o;
     ls.paths.emplace_back();
     ls.box.push_back(sh.offsets[o].box);

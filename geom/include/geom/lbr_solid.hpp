@@ -12,11 +12,13 @@
 //  - Every contour records the id of the move that last changed it (0 = untouched stock).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geom/sweep.hpp"
@@ -104,6 +106,7 @@ struct LevelSections {
   int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // regions that the boxes reach
   bool same_as_below = false;         // equal to the level below's sections
   std::vector<std::uint8_t> same_cell_below;  // per region: same start as the level below
+  std::vector<std::uint32_t> cost;            // per region: the cell's vertices before the batch
   [[nodiscard]] bool empty() const noexcept { return ix1 < ix0 || iy1 < iy0; }
 };
 
@@ -126,6 +129,7 @@ struct SubtractShared {
     }
   };
   std::vector<Offset> offsets;
+  std::atomic<std::size_t> next[3] = {};  // work counters of the phases
 };
 
 // Reusable buffers for subtract(); one per thread that calls it. Grows to the largest batch
@@ -160,6 +164,9 @@ struct SubtractWorkspace {
   };
   std::vector<OffsetKey> offset_keys;      // the batch's distinct (chain, radius), in order
   std::vector<std::uint32_t> offset_of;    // per (level - lb, chain): index into offset_keys, or ~0
+  std::vector<Rect> offset_box;            // per offset: its box
+  std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip
+  std::vector<std::pair<std::size_t, std::uint32_t>> job_cost;  // (estimate, job) for ordering
   SubtractShared own;               // for subtract() on one thread
   std::vector<std::uint32_t> selected, touched;
   std::vector<Polygon> fresh, kept;
@@ -183,7 +190,7 @@ class LbrSolid {
   SubtractStats subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws);
   // The same subtraction run by `count` threads together: each calls it with its own
   // workspace and its index in [0, count), the same batch and the same `shared`; `sync` is a
-  // barrier over the `count` callers (called five times). Each returns its share of the
+  // barrier over the `count` callers (called four times). Each returns its share of the
   // statistics. Phases: every thread prepares the batch (merging, sweeps, chains); the
   // levels' sections are built (levels dealt round robin) and compared with the level
   // below; then the cells that start a run of equal levels are clipped (dealt round robin),
