@@ -81,6 +81,9 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
   j["sections"] = r.stats.sections;
   j["cells_clipped"] = r.stats.cells_clipped;
   j["cells_changed"] = r.stats.cells_changed;
+  j["cells_reused"] = r.stats.cells_reused;
+  j["sections_trimmed"] = r.stats.sections_trimmed;
+  j["sections_in_air"] = r.stats.sections_in_air;
   j["threads"] = r.threads;
   j["peak_rss_mb"] = peak_rss_mb();
   return j.dump(2) + "\n";

@@ -27,6 +27,19 @@ constexpr std::uint32_t kNoChain = 0xFFFFFFFFu;
 
 bool same_contour(const Contour& a, const Contour& b) noexcept { return a.cut_by == b.cut_by && a.pts == b.pts; }
 
+// True when some edge of the closed contour has a box that meets b (conservative: the edge
+// may still miss b).
+bool edge_near(const Path& c, const Rect& b) noexcept {
+  for (std::size_t i = 0, j = c.size() - 1; i < c.size(); j = i++) {
+    const Point& p = c[i];
+    const Point& q = c[j];
+    if (std::max(p.X, q.X) < b.x0 || std::min(p.X, q.X) > b.x1 || std::max(p.Y, q.Y) < b.y0 || std::min(p.Y, q.Y) > b.y1)
+      continue;
+    return true;
+  }
+  return false;
+}
+
 // Vertex for vertex the same polygons, move ids included (cheap tests first).
 bool same_polygons(const Cell& a, const Cell& b) noexcept {
   if (a.polys.size() != b.polys.size() || !(a.bbox == b.bbox) || a.area_units2 != b.area_units2) return false;
@@ -694,6 +707,36 @@ bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, const S
   for (std::uint32_t p = 0; p < cell.polys.size(); ++p)
     if (cell.polys[p].bbox.intersects(clipbox)) ws.touched.push_back(p);
   if (ws.touched.empty()) return false;
+
+  // Sections in the air: when no edge of the material comes near a section's box, the box
+  // lies wholly inside or wholly outside the material, and one point decides which. A
+  // section outside removes nothing and leaves the clip (the shank of a finishing tool over
+  // already cleared levels); when none is left, nothing changes.
+  {
+    std::size_t kept = 0;
+    for (std::uint32_t k : ws.selected) {
+      const Rect& b = ls.box[k];
+      bool near = false, inside = false;
+      const Point centre{b.x0 + (b.x1 - b.x0) / 2, b.y0 + (b.y1 - b.y0) / 2};
+      for (std::uint32_t p : ws.touched) {
+        const Polygon& poly = cell.polys[p];
+        if (!poly.bbox.intersects(b)) continue;
+        near = edge_near(poly.outer.pts, b);
+        for (std::size_t h = 0; !near && h < poly.holes.size(); ++h) near = edge_near(poly.holes[h].pts, b);
+        if (near) break;
+        if (ClipperLib::PointInPolygon(centre, poly.outer.pts) != 0) {
+          inside = true;
+          for (const Contour& h : poly.holes)
+            if (ClipperLib::PointInPolygon(centre, h.pts) != 0) inside = false;
+          if (inside) break;
+        }
+      }
+      if (near || inside) ws.selected[kept++] = k;
+      else ++stats.sections_in_air;
+    }
+    ws.selected.resize(kept);
+    if (ws.selected.empty()) return false;
+  }
 
   ClipperLib::Clipper& c = ws.clipper;
   c.Clear();

@@ -87,10 +87,12 @@ struct SubtractStats {
   std::uint64_t cells_changed = 0;  // cells whose content changed
   std::uint64_t sections_trimmed = 0;  // sections trimmed or dropped inside the previous one
   std::uint64_t cells_reused = 0;      // cells that took the result of the level below
+  std::uint64_t sections_in_air = 0;   // (cell, section) pairs left out: no material there
   SubtractStats& operator+=(const SubtractStats& o) noexcept {
     sections += o.sections; cells_tested += o.cells_tested;
     cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
     sections_trimmed += o.sections_trimmed; cells_reused += o.cells_reused;
+    sections_in_air += o.sections_in_air;
     return *this;
   }
 };
