@@ -128,3 +128,27 @@ TEST(Solid, BooleanDifferenceOfTwoSolids) {
   EXPECT_NEAR(test::removed(a), test::kPi * 100.0 * 4.0, 2 * test::kPi * 20.0 * 0.001 * 4.0);
   EXPECT_EQ(a.check_invariants(), "");
 }
+
+TEST(Solid, SectionsInTheAirLeaveTheDifference) {
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {80, 60, 0}, 0.1, 4, 3));
+  const auto flat = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), 0.001);
+  // A slot 16 mm wide (two passes, y = 30 and 36), 5 mm deep, from x = 10 to 70.
+  test::cut(s, flat, test::at(10, 30, -5), test::at(70, 30, -5), 1);
+  test::cut(s, flat, test::at(10, 36, -5), test::at(70, 36, -5), 1);
+  const double v0 = s.volume_mm3();
+  // The same tool 2 mm above the floor, along the middle of the slot, clear of its walls:
+  // every section is in the air.
+  const geom::SubtractStats air = test::cut(s, flat, test::at(20, 33, -3), test::at(60, 33, -3), 2);
+  EXPECT_EQ(air.cells_clipped, 0u);
+  EXPECT_EQ(air.cells_changed, 0u);
+  EXPECT_GT(air.sections_in_air, 0u);
+  EXPECT_DOUBLE_EQ(s.volume_mm3(), v0);
+  // A move that leaves the slot sideways cuts the wall, 3 mm deep (the tip at -3 lies on a
+  // slab boundary): new area per level = the band y in [41, 50] x 10 mm plus the end
+  // half-disk; the rest of its stadium lies in the slot.
+  const geom::SubtractStats wall = test::cut(s, flat, test::at(40, 33, -3), test::at(40, 50, -3), 3);
+  EXPECT_GT(wall.cells_clipped, 0u);
+  const double area = 9.0 * 10.0 + test::kPi * 25.0 / 2.0;
+  EXPECT_NEAR(v0 - s.volume_mm3(), area * 3.0, 2 * (40.0 + 10.0 * test::kPi) * 0.001 * 3.0);
+  EXPECT_EQ(s.check_invariants(), "");
+}
