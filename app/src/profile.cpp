@@ -216,6 +216,7 @@ void read_live(Section& top, Profile& p, const std::string& name) {
     L.tool = static_cast<int>(s.integer("tool", 1, 0, 9999));
     L.ring_capacity = static_cast<std::size_t>(s.integer("ring_capacity", 4096, 16, 1 << 22));
     L.geometry_idle_us = static_cast<int>(s.integer("geometry_idle_us", 1000, 10, 100000));
+    L.geometry_duty = s.number("geometry_duty", 0.7, 0.1, 1.0, "fraction");
     L.jump_tolerance = s.number("jump_tolerance", 1.5, 1.0, 100.0, "factor");
     L.merge_tolerance_mm = s.number("merge_tolerance_mm", 0.001, 0.0, 1.0, "mm");
     if (const toml::table* st = s.table("serial")) {

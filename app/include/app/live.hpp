@@ -54,6 +54,7 @@ struct LiveResult {
   double stock_volume_mm3 = 0, removed_volume_mm3 = 0;
   double wall_time_s = 0;
   std::string rt_mode;  // "fifo" when both RT threads got SCHED_FIFO, else "non-rt"
+  double batch_p50_ms = 0, batch_p99_ms = 0, batch_max_ms = 0;  // subtract() per geometry tick
 };
 
 using StatusFn = std::function<void(const std::string& line)>;

@@ -42,6 +42,7 @@ struct LiveConfig {
   double merge_tolerance_mm = 0.001;  // samples within this of a straight sweep extend it
   std::size_t ring_capacity = 4096;
   int geometry_idle_us = 1000;     // geometry thread looks at an empty ring again after this [µs]
+  double geometry_duty = 0.7;      // most of the time the geometry thread may work (see live.cpp)
   CanConfig can;
   SerialConfig serial;
   sched::RtConfig hal_thread{"lbr-hal", 80, -1, true};
