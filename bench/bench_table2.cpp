@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
   const std::string png = dir + "/table2.png";
   const std::string cmd =
       "command -v gnuplot >/dev/null 2>&1 && gnuplot -e \"set terminal pngcairo size 900,600 noenhanced; set output '" + png +
-      "'; set datafile separator ','; set logscale y; set yrange [0.001:20]; set key outside; set ylabel 'factor = "
+      "'; set datafile separator ','; set logscale y; set yrange [0.0001:20]; set key outside; set ylabel 'factor = "
       "simulation / machining time'; set xlabel 'regions'; set logscale x 2; set title 'Table 2: lbrsim (one core, "
       "sampled 4 ms) vs the paper'; "
       "plot for [w in 'low medium high'] '" + csv +
