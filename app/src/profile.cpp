@@ -392,7 +392,7 @@ Profile parse_profile(const std::string& text, const std::string& name) {
     Section s(*l, "lbr", name);
     p.solid.level_spacing_mm = s.number("level_spacing_mm", 0.1, 0.001, 1000.0, "mm");
     p.solid.chord_tol_mm = s.number("chord_tolerance_mm", 0.001, 0.0001, 1.0, "mm");
-    p.batch_moves = static_cast<int>(s.integer("batch_moves", 256, 1, 100000));
+    p.batch_moves = static_cast<int>(s.integer("batch_moves", 512, 1, 100000));
     p.threads = static_cast<int>(s.integer("threads", 0, 0, 256));
     if (const toml::node* ss = s.get("strictly_simple")) {
       const auto v = ss->value_exact<bool>();

@@ -45,7 +45,7 @@ struct Profile {
   std::array<double, 3> g54_origin_mm{0, 0, 0};  // machine coordinates of the G54 origin
   geom::SolidSpec solid;    // stock, Δ, region grid, chord tolerance
   bool regions_auto = false;
-  int batch_moves = 256;    // moves per subtract() call in batch mode
+  int batch_moves = 512;    // moves per subtract() call in batch mode
   int threads = 0;          // batch-mode kernel threads (0 = one per hardware thread)
   std::map<int, geom::Tool> tools;             // milling tools (spindle or live tools)
   double render_rate_hz = 30.0;  // [render] rate_hz: the render thread's fixed frame rate
