@@ -426,24 +426,18 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
     }
   }
   const std::size_t noff = ws.offset_keys.size();
-  // Offset boxes from the polyline's box (conservative: the offset lies within r + tol/4 of
-  // it), so that levels can be built while the offsets are being computed.
-  ws.offset_box.resize(noff);
-  for (std::size_t o = 0; o < noff; ++o) {
-    const SubtractWorkspace::Chain& c = ws.chains[ws.offset_keys[o].chain];
-    const Coord d = static_cast<Coord>(std::ceil((ws.offset_keys[o].r + 0.25 * c.shape->chord_tol_mm) * kUnitsPerMm)) + 2;
-    const Rect b = bounds_of(c.pts);
-    ws.offset_box[o] = Rect{b.x0 - d, b.y0 - d, b.x1 + d, b.y1 + d};
-  }
   if (index == 0) {
-    sh.lb = lb;
-    sh.le = le;
     if (sh.levels.size() < static_cast<std::size_t>(n)) sh.levels.resize(static_cast<std::size_t>(n));
     sh.outcome.assign(static_cast<std::size_t>(std::max(n, 0)) * nreg, 0);
     if (sh.offsets.size() < noff) sh.offsets.resize(noff);
     for (std::size_t o = 0; o < noff; ++o) {
+      // The box from the polyline's box (conservative: the offset lies within r + tol/4 of
+      // it), so that levels can be built while the offsets are being computed.
       SubtractShared::Offset& off = sh.offsets[o];
-      off.box = ws.offset_box[o];
+      const SubtractWorkspace::Chain& c = ws.chains[ws.offset_keys[o].chain];
+      const Coord d = static_cast<Coord>(std::ceil((ws.offset_keys[o].r + 0.25 * c.shape->chord_tol_mm) * kUnitsPerMm)) + 2;
+      const Rect b = bounds_of(c.pts);
+      off.box = Rect{b.x0 - d, b.y0 - d, b.x1 + d, b.y1 + d};
       off.ix0 = interval_of(xs_, off.box.x0);
       off.ix1 = interval_of(xs_, off.box.x1);
       off.iy0 = interval_of(ys_, off.box.y0);
@@ -608,7 +602,7 @@ void LbrSolid::build_level(int level, int lb, const SubtractShared& sh, Subtract
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
-  ws.prev_core = Capsule{};
+  Capsule prev_core;  // inside the last vertical section of this level (trim_covered())
   for (std::size_t si = 0; si < ws.sweeps.size(); ++si) {
     const Sweep& sw = ws.sweeps[si];
     if (zc < sw.z_min() || zc > sw.z_max()) continue;
@@ -617,16 +611,16 @@ void LbrSolid::build_level(int level, int lb, const SubtractShared& sh, Subtract
     // Consecutive moves overlap: the vertices of this section inside the previous vertical
     // section's capsule add edges to the clip but remove nothing more (trim_covered()).
     if (sw.vertical() && ls.paths.size() == before + 1) {
-      if (ws.prev_core.valid()) {
+      if (prev_core.valid()) {
         const std::size_t vertices = ls.paths.back().size();
-        if (!trim_covered(ls.paths.back(), ws.prev_core, ws.trim_flags)) {
+        if (!trim_covered(ls.paths.back(), prev_core, ws.trim_flags)) {
           ls.paths.pop_back();
           ++stats.sections_trimmed;
         } else if (ls.paths.back().size() != vertices) {
           ++stats.sections_trimmed;
         }
       }
-      if (ws.scratch.core.valid()) ws.prev_core = ws.scratch.core;
+      if (ws.scratch.core.valid()) prev_core = ws.scratch.core;
     }
     for (std::size_t k = before; k < ls.paths.size(); ++k) {
       ls.box.push_back(bounds_of(ls.paths[k]));

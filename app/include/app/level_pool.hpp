@@ -1,11 +1,11 @@
 // app/level_pool.hpp — batch-mode worker pool: one subtract() spread over threads by level.
 //
 // Levels are independent in the LBR: the threads run LbrSolid::subtract_shared() together,
-// each with its own SubtractWorkspace (levels' sections, then the clips, dealt round robin;
-// runs of equal levels are clipped once). The calling thread is worker 0.
+// each with its own SubtractWorkspace (levels' sections, then the clips, taken from shared
+// counters; runs of equal levels are clipped once). The calling thread is worker 0.
 // Used by the offline runner only; the live geometry thread subtracts on its own.
 //
-// A batch takes well under a millisecond once the kernel is fast (low: ~0.2 ms), so the
+// A batch takes well under a millisecond once the kernel is fast (low: ~0.36 ms), so the
 // hand-over must cost microseconds: workers and the caller spin on atomics for a short while
 // (kSpin) before they block on the condition variables, which are only signalled when
 // someone actually sleeps.

@@ -115,8 +115,7 @@ struct LevelSections {
 // State that the threads of one subtract_shared() call share: written in one phase, read
 // in the next (the caller's barrier orders them).
 struct SubtractShared {
-  int lb = 0, le = 0;                   // the levels the batch reaches
-  std::vector<LevelSections> levels;    // [le - lb), reused between batches
+  std::vector<LevelSections> levels;    // per level the batch reaches, reused between batches
   std::vector<std::uint8_t> outcome;    // per (level - lb, region): the clip changed the cell
   // A chain offset by one radius (one per distinct (chain, radius) of the batch), and its
   // pieces cut to the regions its box reaches (rectangles grown by 1 mm), so that a clip
@@ -157,7 +156,6 @@ struct SubtractWorkspace {
   };
   std::vector<Chain> chains;
   std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
-  Capsule prev_core;                     // inside the last vertical section (trim_covered())
   std::vector<std::uint8_t> trim_flags;
   std::vector<int> source;          // per (level - lb, region): the level whose result it takes
   struct OffsetKey {
@@ -166,7 +164,6 @@ struct SubtractWorkspace {
   };
   std::vector<OffsetKey> offset_keys;      // the batch's distinct (chain, radius), in order
   std::vector<std::uint32_t> offset_of;    // per (level - lb, chain): index into offset_keys, or ~0
-  std::vector<Rect> offset_box;            // per offset: its box
   std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip
   std::vector<std::pair<std::size_t, std::uint32_t>> job_cost;  // (estimate, job) for ordering
   SubtractShared own;               // for subtract() on one thread
@@ -194,10 +191,10 @@ class LbrSolid {
   // workspace and its index in [0, count), the same batch and the same `shared`; `sync` is a
   // barrier over the `count` callers (called four times). Each returns its share of the
   // statistics. Phases: every thread prepares the batch (merging, sweeps, chains); the
-  // levels' sections are built (levels dealt round robin) and compared with the level
-  // below; then the cells that start a run of equal levels are clipped (dealt round robin),
-  // and the rest of each run copies its result (vertical coherence). The result does not
-  // depend on `count`.
+  // chain offsets and the levels' sections are built and compared with the level below;
+  // then the cells that start a run of equal levels are clipped (longest first), and the
+  // rest of each run copies its result (vertical coherence). Work inside a phase is taken
+  // from shared counters. The result does not depend on `count`.
   SubtractStats subtract_shared(std::span<const SweepRef> batch, SubtractShared& shared, SubtractWorkspace& ws,
                                 int index, int count, const std::function<void()>& sync);
 
