@@ -34,6 +34,21 @@ line 60 30 -3
 line 20 30 -1
 )";
 
+// Runs `program` (a move list, written to TEMP/subdir/name) through the emulator source as
+// fast as possible.
+app::LiveResult run_emulated(const app::Profile& p, const std::string& program, const std::string& subdir,
+                             const std::string& name) {
+  const std::string dir = testing::TempDir() + "/" + subdir;
+  std::filesystem::create_directories(dir);
+  const std::string file = dir + "/" + name;
+  std::ofstream(file) << program;
+  std::atomic<bool> stop{false};
+  app::LiveOptions o;
+  o.source = "emulator:" + file;
+  o.speed = 0.0;
+  return app::run_live(p, o, stop);
+}
+
 }  // namespace
 
 TEST(LiveProfile, DefaultsAndMapping) {
@@ -101,15 +116,7 @@ TEST(LiveRun, EmulatorWithToolChangesMatchesBatch) {
   // Two tools: the emulator source reports the tool number, so each part cuts with its tool.
   const app::Profile p = app::default_profile();
   const std::string program = std::string(kShortProgram) + "rapid 20 30 5\ntool 2\nrapid 30 60 5\nline 30 60 -2\nline 80 60 -2\nrapid 80 60 5\n";
-  const std::string dir = testing::TempDir() + "/lbr_live_emu";
-  std::filesystem::create_directories(dir);
-  const std::string file = dir + "/two-tools.moves";
-  std::ofstream(file) << program;
-  std::atomic<bool> stop{false};
-  app::LiveOptions o;
-  o.source = "emulator:" + file;
-  o.speed = 0.0;
-  const app::LiveResult r = app::run_live(p, o, stop);
+  const app::LiveResult r = run_emulated(p, program, "lbr_live_emu", "two-tools.moves");
   const nc::Toolpath path = nc::parse_movelist(program, "two-tools");
   const app::BatchResult b = app::run_batch(p, path);
   EXPECT_EQ(r.samples_lost, 0u);
@@ -128,15 +135,7 @@ TEST(LiveRun, StraightRunsMergeIntoOneSweepPerBatch) {
   app::Profile p = app::default_profile();
   p.batch_moves = 64;
   const std::string program = "lbr-moves 1\nstart 5 20 5\ntool 1\nfeed 3000\nrapid 5 20 -2\nline 95 20 -2\n";
-  const std::string dir = testing::TempDir() + "/lbr_live_line";
-  std::filesystem::create_directories(dir);
-  const std::string file = dir + "/line.moves";
-  std::ofstream(file) << program;
-  std::atomic<bool> stop{false};
-  app::LiveOptions o;
-  o.source = "emulator:" + file;
-  o.speed = 0.0;
-  const app::LiveResult r = app::run_live(p, o, stop);
+  const app::LiveResult r = run_emulated(p, program, "lbr_live_line", "line.moves");
   EXPECT_GT(r.samples_applied, 1500u);  // 90 mm at 50 mm/s plus the plunge
   EXPECT_LE(r.sweeps, r.batches + 2);    // + the corner at the plunge's end, within one batch
   EXPECT_LT(r.sweeps * 20, r.samples_applied);

@@ -111,9 +111,8 @@ TEST(LatheC, RadialCrossHoleThroughTheBar) {
   EXPECT_EQ(s.check_invariants(), "");
 }
 
-TEST(LatheC, HexagonByPolarMillingHasItsAcrossFlats) {
-  // Through the whole batch path: profile, X/C tool path, kinematics, sub-steps.
-  const app::Profile p = app::parse_profile(R"(
+// Ø40 cylinder on a C-axis lathe with a 6 mm axial live tool: both hexagon tests.
+constexpr const char* kLatheCHexProfile = R"(
 [machine]
 kind = "lathe-c"
 [stock]
@@ -131,7 +130,11 @@ kind = "flat"
 diameter_mm = 6
 flute_length_mm = 18
 live = "axial"
-)", "hex.toml");
+)";
+
+TEST(LatheC, HexagonByPolarMillingHasItsAcrossFlats) {
+  // Through the whole batch path: profile, X/C tool path, kinematics, sub-steps.
+  const app::Profile p = app::parse_profile(kLatheCHexProfile, "hex.toml");
   nc::Toolpath path;
   path.start = q_of(30, 0, 5);
   path.start_tool = 1;
@@ -173,25 +176,7 @@ live = "axial"
 }
 
 TEST(LatheC, HexagonByG12_1PolarInterpolation) {
-  const app::Profile p = app::parse_profile(R"(
-[machine]
-kind = "lathe-c"
-[stock]
-shape = "cylinder"
-center_mm = [0, 0]
-diameter_mm = 40
-z_min_mm = -12
-z_max_mm = 0
-[lbr]
-level_spacing_mm = 0.25
-regions = "2x2"
-[[tool]]
-number = 1
-kind = "flat"
-diameter_mm = 6
-flute_length_mm = 18
-live = "axial"
-)", "hex.toml");
+  const app::Profile p = app::parse_profile(kLatheCHexProfile, "hex.toml");
   // G7: X words are diameters of the Cartesian x; C words are the Cartesian y [mm].
   const std::string prog =
       "G18 G7 G90 G21\nT1 M6\nG0 X80 Z5\nG0 X41.569219 C30\nG12.1\nG1 Z-5 F300\n"

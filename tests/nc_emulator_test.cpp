@@ -57,21 +57,6 @@ std::vector<Sample> all_samples(Emulator& em) {
   return v;
 }
 
-double dist_to_segment(const AxisVector& p, const AxisVector& a, const AxisVector& b) {
-  double ab2 = 0, t = 0;
-  for (int i = 0; i < kAxes; ++i) {
-    ab2 += (b[i] - a[i]) * (b[i] - a[i]);
-    t += (p[i] - a[i]) * (b[i] - a[i]);
-  }
-  t = ab2 > 0 ? std::clamp(t / ab2, 0.0, 1.0) : 0.0;
-  double d2 = 0;
-  for (int i = 0; i < kAxes; ++i) {
-    const double q = a[i] + t * (b[i] - a[i]) - p[i];
-    d2 += q * q;
-  }
-  return std::sqrt(d2);
-}
-
 TEST(Emulator, TrapezoidTimeMatchesClosedForm) {
   // 100 mm at 6000 mm/min = 100 mm/s with 1000 mm/s²: t = L/v + v/a = 1.1 s.
   Emulator em(line_path(100, 6000), limits());
@@ -192,7 +177,7 @@ TEST_F(EmulatorProgram, SamplesLieOnTheProgrammedPath) {
   std::uint64_t n = 0;
   while (em.next(s)) {
     // Segments are visited in order: advance until the sample lies on the current one.
-    while (seg < path_.segments.size() && dist_to_segment(s.axes, from, path_.segments[seg].end) > 1e-9) {
+    while (seg < path_.segments.size() && lbr::test::axis_dist_to_segment(s.axes, from, path_.segments[seg].end) > 1e-9) {
       from = path_.segments[seg].end;
       ++seg;
     }

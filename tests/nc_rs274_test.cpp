@@ -100,21 +100,6 @@ GcodeOptions recorded_options(double chord_tol_mm) {
   return o;
 }
 
-double dist_to_segment(const AxisVector& p, const AxisVector& a, const AxisVector& b) {
-  double ab2 = 0, t = 0;
-  for (int i = 0; i < kAxes; ++i) {
-    ab2 += (b[i] - a[i]) * (b[i] - a[i]);
-    t += (p[i] - a[i]) * (b[i] - a[i]);
-  }
-  t = ab2 > 0 ? std::clamp(t / ab2, 0.0, 1.0) : 0.0;
-  double d2 = 0;
-  for (int i = 0; i < kAxes; ++i) {
-    const double q = a[i] + t * (b[i] - a[i]) - p[i];
-    d2 += q * q;
-  }
-  return std::sqrt(d2);
-}
-
 // Every vertex of `a` lies within tol of `b`'s polyline, visited in order. Returns the
 // largest distance seen, or +inf when a vertex has no match.
 double directed_distance(const Toolpath& a, const Toolpath& b, double tol) {
@@ -127,7 +112,7 @@ double directed_distance(const Toolpath& a, const Toolpath& b, double tol) {
     AxisVector from = bfrom;
     bool found = false;
     for (; k < b.segments.size(); ++k) {
-      const double d = dist_to_segment(s.end, from, b.segments[k].end);
+      const double d = lbr::test::axis_dist_to_segment(s.end, from, b.segments[k].end);
       if (d <= tol) {
         worst = std::max(worst, d);
         found = true;
