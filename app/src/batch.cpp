@@ -164,37 +164,38 @@ void run_moves(const Profile& profile, const std::vector<TimedMove>& moves, Batc
   LevelPool pool(profile.threads);
   r.threads = pool.threads();
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<geom::SweepRef> batch;
-  batch.reserve(static_cast<std::size_t>(profile.batch_moves));
   auto last_report = t0;
   // Within one subtract() call the order of the sweeps does not matter (their union is
   // removed), so a batch is grouped by channel: each channel's consecutive sampled moves
   // then merge into long sweeps (merge_collinear) instead of alternating with the others'.
-  std::size_t begin = 0;
   std::vector<const TimedMove*> group;
-  auto flush = [&](std::size_t end) {
+  auto fill = [&](std::size_t begin, std::size_t end, std::vector<geom::SweepRef>& out) {
     group.clear();
     for (std::size_t k = begin; k < end; ++k) group.push_back(&moves[k]);
     std::stable_sort(group.begin(), group.end(),
                      [](const TimedMove* a, const TimedMove* b) { return a->channel < b->channel; });
-    for (const TimedMove* m : group) batch.push_back(m->ref);
-    if (!batch.empty()) r.stats += pool.subtract(r.solid, batch);
-    batch.clear();
-    begin = end;
+    out.clear();
+    for (const TimedMove* m : group) out.push_back(m->ref);
   };
-  for (std::size_t i = 0; i < moves.size(); ++i) {
-    if (static_cast<int>(i + 1 - begin) >= profile.batch_moves) {
-      flush(i + 1);
-      if (progress) {
-        const auto now = std::chrono::steady_clock::now();
-        if (now - last_report > std::chrono::seconds(1)) {
-          last_report = now;
-          progress(static_cast<double>(i + 1) / static_cast<double>(moves.size()));
-        }
+  // Batches of profile.batch_moves moves; the pool gets the next one too (LevelPool::subtract).
+  const std::size_t per = static_cast<std::size_t>(std::max(1, profile.batch_moves));
+  std::vector<geom::SweepRef> batch[2];
+  if (!moves.empty()) fill(0, std::min(per, moves.size()), batch[0]);
+  for (std::size_t begin = 0, k = 0; begin < moves.size(); begin += per, ++k) {
+    const std::size_t next = begin + per;
+    std::vector<geom::SweepRef>& now = batch[k % 2];
+    std::vector<geom::SweepRef>& ahead = batch[(k + 1) % 2];
+    ahead.clear();
+    if (next < moves.size()) fill(next, std::min(next + per, moves.size()), ahead);
+    if (!now.empty()) r.stats += pool.subtract(r.solid, now, ahead);
+    if (progress) {
+      const auto now_t = std::chrono::steady_clock::now();
+      if (now_t - last_report > std::chrono::seconds(1)) {
+        last_report = now_t;
+        progress(static_cast<double>(std::min(next, moves.size())) / static_cast<double>(moves.size()));
       }
     }
   }
-  flush(moves.size());
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.removed_volume_mm3 = r.stock_volume_mm3 - r.solid.volume_mm3();
   if (progress) progress(1.0);

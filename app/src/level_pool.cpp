@@ -11,6 +11,16 @@ namespace {
 // the offline runner, far shorter than a scheduler tick.
 constexpr auto kSpin = std::chrono::microseconds(200);
 
+bool same_batch(std::span<const geom::SweepRef> a, std::span<const geom::SweepRef> b) noexcept {
+  auto pose = [](const geom::Pose& p, const geom::Pose& q) {
+    return p.tip.x == q.tip.x && p.tip.y == q.tip.y && p.tip.z == q.tip.z && p.axis.x == q.axis.x &&
+           p.axis.y == q.axis.y && p.axis.z == q.axis.z;
+  };
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [&](const geom::SweepRef& x, const geom::SweepRef& y) {
+    return x.shape == y.shape && x.turning == y.turning && x.id == y.id && pose(x.from, y.from) && pose(x.to, y.to);
+  });
+}
+
 inline void relax() noexcept {
 #if defined(__x86_64__) || defined(__i386__)
   __builtin_ia32_pause();
@@ -73,9 +83,7 @@ void LevelPool::worker(int index) {
     }
     if (stop_.load(std::memory_order_acquire)) return;
     seen = generation_.load(std::memory_order_acquire);
-    geom::LbrSolid* solid = solid_;
-    const auto batch = batch_;
-    results_[index] = solid->subtract_shared(batch, shared_, *workspaces_[index], index, threads(), sync_);
+    results_[index] = solid_->subtract_shared(shared_[cur_], *workspaces_[index], index, threads(), sync_, ahead_);
     if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
       std::lock_guard lk(m_);
       if (caller_waiting_) done_.notify_one();
@@ -83,17 +91,28 @@ void LevelPool::worker(int index) {
   }
 }
 
-geom::SubtractStats LevelPool::subtract(geom::LbrSolid& solid, std::span<const geom::SweepRef> batch) {
+geom::SubtractStats LevelPool::subtract(geom::LbrSolid& solid, std::span<const geom::SweepRef> batch,
+                                        std::span<const geom::SweepRef> next) {
   if (threads_.empty()) return solid.subtract(batch, *workspaces_[0]);
+  // Prepared before the workers start (they only read it): this batch, unless the call
+  // before prepared it as its `next` for this solid, and the next one.
+  if (ahead_valid_ && solid_ == &solid && same_batch(batch, ahead_batch_)) cur_ = 1 - cur_;
+  else solid.prepare_shared(batch, shared_[cur_]);
   solid_ = &solid;
-  batch_ = batch;
+  ahead_valid_ = !next.empty();
+  ahead_ = nullptr;
+  if (ahead_valid_) {
+    ahead_batch_.assign(next.begin(), next.end());
+    ahead_ = &shared_[1 - cur_];
+    solid.prepare_shared(next, *ahead_);
+  }
   pending_.store(static_cast<int>(threads_.size()), std::memory_order_relaxed);
   {
     std::lock_guard lk(m_);
     generation_.fetch_add(1, std::memory_order_release);
     if (sleepers_ > 0) start_.notify_all();
   }
-  results_[0] = solid.subtract_shared(batch, shared_, *workspaces_[0], 0, threads(), sync_);
+  results_[0] = solid.subtract_shared(shared_[cur_], *workspaces_[0], 0, threads(), sync_, ahead_);
   auto done = [&] { return pending_.load(std::memory_order_acquire) == 0; };
   if (!spin_until(done)) {
     std::unique_lock lk(m_);
@@ -101,6 +120,7 @@ geom::SubtractStats LevelPool::subtract(geom::LbrSolid& solid, std::span<const g
     done_.wait(lk, done);
     caller_waiting_ = false;
   }
+  if (ahead_ != nullptr) ahead_->offsets_ready = true;  // every worker is done
   geom::SubtractStats total;
   for (const auto& r : results_) total += r;
   return total;

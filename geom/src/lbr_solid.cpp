@@ -258,7 +258,8 @@ SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch) { return subtr
 
 SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws) {
   static const std::function<void()> kNoSync = [] {};
-  return subtract_shared(batch, ws.own, ws, 0, 1, kNoSync);
+  prepare_shared(batch, ws.own);
+  return subtract_shared(ws.own, ws, 0, 1, kNoSync);
 }
 
 namespace {
@@ -333,39 +334,38 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
   }
 }
 
-// Merges the batch and builds its sweeps, chains and turning sweeps in `ws`; returns the
-// lowest height they reach (zhi: the highest), or +inf when there is nothing to cut.
-double LbrSolid::prepare(std::span<const SweepRef> batch, SubtractWorkspace& ws, double& zhi) const {
-  merge_collinear(batch, ws.merged);
-  ws.sweeps.clear();
-  ws.sweep_id.clear();
-  ws.lathe.clear();
-  ws.lathe_id.clear();
-  ws.chain_count = 0;
-  double zlo = INFINITY;
-  zhi = -INFINITY;
+void LbrSolid::prepare_shared(std::span<const SweepRef> batch, SubtractShared& sh) const {
+  // The batch merged, then its sweeps, chains and turning sweeps, and the range they reach.
+  merge_collinear(batch, sh.merged);
+  sh.sweeps.clear();
+  sh.sweep_id.clear();
+  sh.lathe.clear();
+  sh.lathe_id.clear();
+  sh.chain_count = 0;
+  double zlo = INFINITY, zhi = -INFINITY;
   auto horizontal = [](const SweepRef& r) {
     return r.turning == nullptr && r.shape != nullptr && r.from.tip.z == r.to.tip.z && r.from.axis.x == 0.0 &&
            r.from.axis.y == 0.0 && r.from.axis.z > 0.0 && r.to.axis.x == 0.0 && r.to.axis.y == 0.0 && r.to.axis.z > 0.0;
   };
-  for (std::size_t i = 0; i < ws.merged.size(); ++i) {
-    const SweepRef& s = ws.merged[i];
+  const std::vector<SweepRef>& merged = sh.merged;
+  for (std::size_t i = 0; i < merged.size(); ++i) {
+    const SweepRef& s = merged[i];
     if (horizontal(s)) {
       std::size_t j = i + 1;
-      while (j < ws.merged.size() && horizontal(ws.merged[j]) && ws.merged[j].shape == s.shape &&
-             ws.merged[j].from.tip.z == s.from.tip.z && ws.merged[j].from.tip == ws.merged[j - 1].to.tip)
+      while (j < merged.size() && horizontal(merged[j]) && merged[j].shape == s.shape &&
+             merged[j].from.tip.z == s.from.tip.z && merged[j].from.tip == merged[j - 1].to.tip)
         ++j;
       if (j - i >= 3) {
-        if (ws.chains.size() <= ws.chain_count) ws.chains.emplace_back();
-        SubtractWorkspace::Chain& c = ws.chains[ws.chain_count++];
+        if (sh.chains.size() <= sh.chain_count) sh.chains.emplace_back();
+        SubtractShared::Chain& c = sh.chains[sh.chain_count++];
         c.shape = s.shape;
         c.z = s.from.tip.z;
         c.pts.clear();
         c.pts.push_back({to_units(s.from.tip.x), to_units(s.from.tip.y)});
         c.id = 0;
         for (std::size_t k = i; k < j; ++k) {
-          c.pts.push_back({to_units(ws.merged[k].to.tip.x), to_units(ws.merged[k].to.tip.y)});
-          c.id = std::max(c.id, ws.merged[k].id);
+          c.pts.push_back({to_units(merged[k].to.tip.x), to_units(merged[k].to.tip.y)});
+          c.id = std::max(c.id, merged[k].id);
         }
         zlo = std::min(zlo, c.z);
         zhi = std::max(zhi, c.z + s.shape->height());
@@ -374,104 +374,116 @@ double LbrSolid::prepare(std::span<const SweepRef> batch, SubtractWorkspace& ws,
       }
     }
     if (s.turning != nullptr) {
-      ws.lathe.emplace_back(*s.turning, s.from.tip.x, s.from.tip.z, s.to.tip.x, s.to.tip.z);
-      ws.lathe_id.push_back(s.id);
-      zlo = std::min(zlo, ws.lathe.back().z_min());
-      zhi = std::max(zhi, ws.lathe.back().z_max());
+      sh.lathe.emplace_back(*s.turning, s.from.tip.x, s.from.tip.z, s.to.tip.x, s.to.tip.z);
+      sh.lathe_id.push_back(s.id);
+      zlo = std::min(zlo, sh.lathe.back().z_min());
+      zhi = std::max(zhi, sh.lathe.back().z_max());
       continue;
     }
-    ws.sweeps.emplace_back(*s.shape, s.from, s.to);
-    ws.sweep_id.push_back(s.id);
-    zlo = std::min(zlo, ws.sweeps.back().z_min());
-    zhi = std::max(zhi, ws.sweeps.back().z_max());
+    sh.sweeps.emplace_back(*s.shape, s.from, s.to);
+    sh.sweep_id.push_back(s.id);
+    zlo = std::min(zlo, sh.sweeps.back().z_min());
+    zhi = std::max(zhi, sh.sweeps.back().z_max());
   }
-  return zlo;
-}
-
-SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, SubtractShared& sh, SubtractWorkspace& ws,
-                                        int index, int count, const std::function<void()>& sync) {
-  SubtractStats stats;
-  // Every thread prepares the same batch (cheap next to clipping) and derives the same range.
-  double zhi = -INFINITY;
-  const double zlo = prepare(batch, ws, zhi);
-  const bool nothing = (ws.sweeps.empty() && ws.lathe.empty() && ws.chain_count == 0) || zhi < z0_ || zlo > z1_;
-  const int lb = nothing ? 0 : level_at(zlo);
-  const int le = nothing ? 0 : level_at(zhi) + 1;
-  const int n = le - lb;
+  const bool nothing = (sh.sweeps.empty() && sh.lathe.empty() && sh.chain_count == 0) || zhi < z0_ || zlo > z1_;
+  sh.lb = nothing ? 0 : level_at(zlo);
+  sh.le = nothing ? 0 : level_at(zhi) + 1;
+  const int n = sh.le - sh.lb;
   const std::size_t nreg = static_cast<std::size_t>(regions());
-  // The distinct (chain, radius) pairs of the batch, in level order (the same in every
-  // thread): a flat tool's chain has one radius on all its levels.
-  const std::size_t cc = ws.chain_count;
-  ws.offset_keys.clear();
-  ws.offset_of.assign(static_cast<std::size_t>(std::max(n, 0)) * cc, kNoChain);
-  for (int l = lb; l < le; ++l) {
+  // The distinct (chain, radius) pairs of the batch, in level order: a flat tool's chain
+  // has one radius on all its levels.
+  const std::size_t cc = sh.chain_count;
+  sh.offset_keys.clear();
+  sh.offset_of.assign(static_cast<std::size_t>(n) * cc, kNoChain);
+  for (int l = sh.lb; l < sh.le; ++l) {
     const double zc = level_z_mm(l);
     for (std::size_t ci = 0; ci < cc; ++ci) {
-      const SubtractWorkspace::Chain& c = ws.chains[ci];
+      const SubtractShared::Chain& c = sh.chains[ci];
       const double h = zc - c.z;
       if (h < 0.0 || h > c.shape->height()) continue;
       const double r = c.shape->radius_at(h);
       if (r <= 0.0) continue;
       std::uint32_t o = kNoChain;
-      for (std::size_t k = ws.offset_keys.size(); k-- > 0;)
-        if (ws.offset_keys[k].chain == ci && ws.offset_keys[k].r == r) {
+      for (std::size_t k = sh.offset_keys.size(); k-- > 0;)
+        if (sh.offset_keys[k].chain == ci && sh.offset_keys[k].r == r) {
           o = static_cast<std::uint32_t>(k);
           break;
         }
       if (o == kNoChain) {
-        o = static_cast<std::uint32_t>(ws.offset_keys.size());
-        ws.offset_keys.push_back({static_cast<std::uint32_t>(ci), r});
+        o = static_cast<std::uint32_t>(sh.offset_keys.size());
+        sh.offset_keys.push_back({static_cast<std::uint32_t>(ci), r});
       }
-      ws.offset_of[static_cast<std::size_t>(l - lb) * cc + ci] = o;
+      sh.offset_of[static_cast<std::size_t>(l - sh.lb) * cc + ci] = o;
     }
   }
-  const std::size_t noff = ws.offset_keys.size();
-  if (index == 0) {
-    if (sh.levels.size() < static_cast<std::size_t>(n)) sh.levels.resize(static_cast<std::size_t>(n));
-    sh.outcome.assign(static_cast<std::size_t>(std::max(n, 0)) * nreg, 0);
-    if (sh.offsets.size() < noff) sh.offsets.resize(noff);
-    for (std::size_t o = 0; o < noff; ++o) {
-      // The box from the polyline's box (conservative: the offset lies within r + tol/4 of
-      // it), so that levels can be built while the offsets are being computed.
-      SubtractShared::Offset& off = sh.offsets[o];
-      const SubtractWorkspace::Chain& c = ws.chains[ws.offset_keys[o].chain];
-      const Coord d = static_cast<Coord>(std::ceil((ws.offset_keys[o].r + 0.25 * c.shape->chord_tol_mm) * kUnitsPerMm)) + 2;
-      const Rect b = bounds_of(c.pts);
-      off.box = Rect{b.x0 - d, b.y0 - d, b.x1 + d, b.y1 + d};
-      off.ix0 = interval_of(xs_, off.box.x0);
-      off.ix1 = interval_of(xs_, off.box.x1);
-      off.iy0 = interval_of(ys_, off.box.y0);
-      off.iy1 = interval_of(ys_, off.box.y1);
-      off.cut.resize(static_cast<std::size_t>((off.ix1 - off.ix0 + 1) * (off.iy1 - off.iy0 + 1)));
-    }
-    for (auto& next : sh.next) next.store(0, std::memory_order_relaxed);
+  const std::size_t noff = sh.offset_keys.size();
+  if (sh.levels.size() < static_cast<std::size_t>(n)) sh.levels.resize(static_cast<std::size_t>(n));
+  sh.outcome.assign(static_cast<std::size_t>(n) * nreg, 0);
+  if (sh.offsets.size() < noff) sh.offsets.resize(noff);
+  for (std::size_t o = 0; o < noff; ++o) {
+    // The box from the polyline's box (conservative: the offset lies within r + tol/4 of
+    // it), so that levels can be built while the offsets are being computed.
+    SubtractShared::Offset& off = sh.offsets[o];
+    const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
+    const Coord d = static_cast<Coord>(std::ceil((sh.offset_keys[o].r + 0.25 * c.shape->chord_tol_mm) * kUnitsPerMm)) + 2;
+    const Rect b = bounds_of(c.pts);
+    off.box = Rect{b.x0 - d, b.y0 - d, b.x1 + d, b.y1 + d};
+    off.ix0 = interval_of(xs_, off.box.x0);
+    off.ix1 = interval_of(xs_, off.box.x1);
+    off.iy0 = interval_of(ys_, off.box.y0);
+    off.iy1 = interval_of(ys_, off.box.y1);
+    const std::size_t pieces = static_cast<std::size_t>((off.ix1 - off.ix0 + 1) * (off.iy1 - off.iy0 + 1));
+    off.cut.resize(pieces);
+    off.state.assign(pieces, 0);
+    off.whole.assign(pieces, 0);
   }
-  sync();  // (1) shared storage sized
-  if (n <= 0) {
-    for (int i = 0; i < 3; ++i) sync();
-    return stats;
-  }
+  for (auto& next : sh.next) next.store(0, std::memory_order_relaxed);
+  sh.offsets_ready = false;
+}
+
+namespace {
+
+// Builds offset `o` of the prepared batch. Offset vertices lie on radius r + tol/4 and
+// chords sag at most tol/2 inside it, so the boundary stays within ±tol/4 of the exact one.
+void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
+  ++stats.chain_offsets;
+  const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
+  SubtractShared::Offset& off = sh.offsets[o];
+  const double tol = c.shape->chord_tol_mm;
+  ClipperLib::ClipperOffset co(2.0, 0.5 * tol * kUnitsPerMm);
+  co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
+  off.paths.clear();
+  co.Execute(off.paths, (sh.offset_keys[o].r + 0.25 * tol) * kUnitsPerMm);
+}
+
+}  // namespace
+
+SubtractStats LbrSolid::subtract_shared(SubtractShared& sh, SubtractWorkspace& ws, int index, int count,
+                                        const std::function<void()>& sync, SubtractShared* ahead) {
+  SubtractStats stats;
+  const int lb = sh.lb, le = sh.le, n = le - lb;
   // Work is taken from shared counters, so a thread that gets a long item takes fewer of
   // the rest; which thread does an item never changes the result.
   auto take = [&](int phase) { return sh.next[static_cast<std::size_t>(phase)].fetch_add(1, std::memory_order_relaxed); };
-  // Phase A: the chain offsets (items [0, noff)) and the levels' sections (the rest); for
-  // the cells a level reaches, whether the cell starts equal to the one below (read only:
-  // nothing changes before phase C). Offset vertices lie on radius r + tol/4 and chords sag
-  // at most tol/2 inside it, so the boundary stays within ±tol/4 of the exact one.
+  // Phase C's first items: the next batch's offsets.
+  const std::size_t pre = ahead != nullptr ? ahead->offset_keys.size() : 0;
+  if (n <= 0) {  // the same in every thread: nobody waits
+    for (std::size_t item = take(1); item < pre; item = take(1)) build_offset(*ahead, item, stats);
+    return stats;
+  }
+  const std::size_t nreg = static_cast<std::size_t>(regions());
+  const std::size_t noff = sh.offsets_ready ? 0 : sh.offset_keys.size();
+  // Phase A: the chain offsets unless built ahead (items [0, noff)) and the levels'
+  // sections (the rest); for the cells a level reaches, whether the cell starts equal to
+  // the one below (read only: nothing changes before phase C).
   for (std::size_t item = take(0); item < noff + static_cast<std::size_t>(n); item = take(0)) {
     if (item < noff) {
-      const SubtractWorkspace::Chain& c = ws.chains[ws.offset_keys[item].chain];
-      SubtractShared::Offset& off = sh.offsets[item];
-      const double tol = c.shape->chord_tol_mm;
-      ClipperLib::ClipperOffset co(2.0, 0.5 * tol * kUnitsPerMm);
-      co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
-      off.paths.clear();
-      co.Execute(off.paths, (ws.offset_keys[item].r + 0.25 * tol) * kUnitsPerMm);
+      build_offset(sh, item, stats);
       continue;
     }
     const int l = lb + static_cast<int>(item - noff);
     LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
-    build_level(l, lb, sh, ws, ls, stats);
+    build_level(l, sh, ws, ls, stats);
     ls.same_cell_below.assign(nreg, 0);
     ls.cost.assign(nreg, 0);
     for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
@@ -488,50 +500,20 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
           ls.same_cell_below[static_cast<std::size_t>(region)] = same_polygons(c, cell(region, l - 1)) ? 1 : 0;
       }
   }
-  sync();  // (2) offsets and sections built
-  // Phase A2: the offsets' region pieces (items over every offset's regions), then which
-  // levels have the sections of the level below.
-  std::size_t pieces = 0;
-  for (std::size_t o = 0; o < noff; ++o) pieces += sh.offsets[o].cut.size();
-  for (std::size_t item = take(1); item < pieces + static_cast<std::size_t>(n); item = take(1)) {
-    if (item < pieces) {
-      std::size_t o = 0, i = item;
-      while (i >= sh.offsets[o].cut.size()) i -= sh.offsets[o++].cut.size();
-      SubtractShared::Offset& off = sh.offsets[o];
-      const int w = off.ix1 - off.ix0 + 1;
-      const int ix = off.ix0 + static_cast<int>(i) % w, iy = off.iy0 + static_cast<int>(i) / w;
-      Paths& out = off.cut[i];
-      out.clear();
-      Rect rr = region_rect(iy * spec_.regions_x + ix);
-      const Coord grow = static_cast<Coord>(kUnitsPerMm);
-      rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
-      if (off.box.x0 >= rr.x0 && off.box.x1 <= rr.x1 && off.box.y0 >= rr.y0 && off.box.y1 <= rr.y1) {
-        out = off.paths;  // wholly inside: nothing to cut
-        continue;
-      }
-      ClipperLib::Clipper& k = ws.rect_clipper;
-      k.Clear();
-      k.AddPaths(off.paths, ClipperLib::ptSubject, true);
-      k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
-      k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-      continue;
-    }
-    const int l = lb + static_cast<int>(item - pieces);
-    LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
-    ls.same_as_below = false;
-    if (!spec_.vertical_coherence || l == lb || ls.empty()) continue;
-    const LevelSections& lo = sh.levels[static_cast<std::size_t>(l - 1 - lb)];
-    ls.same_as_below = !lo.empty() && ls.chain_offset == lo.chain_offset && ls.paths == lo.paths;
-  }
-  sync();  // (3)
-  // Phase B, within this thread: the level each cell takes its result from, and the list
-  // of cells that start a run. Every thread derives the same table.
+  sync();  // (1) offsets and sections built
+  // Phase B, within this thread: which levels have the sections of the level below, the
+  // level each cell takes its result from, and the list of cells that start a run. Every
+  // thread derives the same table.
   ws.source.assign(static_cast<std::size_t>(n) * nreg, -1);
   ws.jobs.clear();
   for (int l = lb; l < le; ++l) {
-    LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
+    const LevelSections& ls = sh.levels[static_cast<std::size_t>(l - lb)];
     if (ls.empty()) continue;
-    const bool same = ls.same_as_below;
+    bool same = false;
+    if (spec_.vertical_coherence && l > lb) {
+      const LevelSections& lo = sh.levels[static_cast<std::size_t>(l - 1 - lb)];
+      same = !lo.empty() && ls.chain_offset == lo.chain_offset && ls.paths == lo.paths;
+    }
     for (int iy = ls.iy0; iy <= ls.iy1; ++iy)
       for (int ix = ls.ix0; ix <= ls.ix1; ++ix) {
         const std::size_t region = static_cast<std::size_t>(iy * spec_.regions_x + ix);
@@ -555,12 +537,16 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
     });
     for (std::size_t j = 0; j < ws.jobs.size(); ++j) ws.jobs[j] = ws.job_cost[j].second;
   }
-  for (std::size_t j = take(2); j < ws.jobs.size(); j = take(2)) {
-    const std::size_t k = ws.jobs[j];
+  for (std::size_t item = take(1); item < pre + ws.jobs.size(); item = take(1)) {
+    if (item < pre) {
+      build_offset(*ahead, item, stats);
+      continue;
+    }
+    const std::size_t k = ws.jobs[item - pre];
     const int l = lb + static_cast<int>(k / nreg), region = static_cast<int>(k % nreg);
     sh.outcome[k] = clip_cell(region, l, sh.levels[k / nreg], sh, ws, stats) ? 1 : 0;
   }
-  sync();  // (4) every run's first cell is final
+  sync();  // (2) every run's first cell is final
   // Phase D: the other cells of each run take its result.
   std::size_t copy = 0;
   for (int l = lb; l < le; ++l) {
@@ -590,7 +576,7 @@ SubtractStats LbrSolid::subtract_shared(std::span<const SweepRef> batch, Subtrac
   return stats;
 }
 
-void LbrSolid::build_level(int level, int lb, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
+void LbrSolid::build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                            SubtractStats& stats) const {
   const double zc = level_z_mm(level);
   for (Path& p : ls.paths) ws.scratch.spare.push_back(std::move(p));  // keep the buffers
@@ -598,13 +584,13 @@ void LbrSolid::build_level(int level, int lb, const SubtractShared& sh, Subtract
   ls.box.clear();
   ls.id.clear();
   ls.chain.clear();
-  ls.chain_offset.assign(ws.chain_count, kNoChain);
+  ls.chain_offset.assign(sh.chain_count, kNoChain);
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
   Capsule prev_core;  // inside the last vertical section of this level (trim_covered())
-  for (std::size_t si = 0; si < ws.sweeps.size(); ++si) {
-    const Sweep& sw = ws.sweeps[si];
+  for (std::size_t si = 0; si < sh.sweeps.size(); ++si) {
+    const Sweep& sw = sh.sweeps[si];
     if (zc < sw.z_min() || zc > sw.z_max()) continue;
     const std::size_t before = ls.paths.size();
     sw.section(zc, ls.paths, ws.scratch);
@@ -624,40 +610,40 @@ void LbrSolid::build_level(int level, int lb, const SubtractShared& sh, Subtract
     }
     for (std::size_t k = before; k < ls.paths.size(); ++k) {
       ls.box.push_back(bounds_of(ls.paths[k]));
-      ls.id.push_back(ws.sweep_id[si]);
+      ls.id.push_back(sh.sweep_id[si]);
       ls.all.add(ls.box.back());
     }
   }
   ls.chain.assign(ls.paths.size(), kNoChain);
   // Chains: one entry for the whole offset (outer contours and holes); a clip adds its
   // piece cut to the region (SubtractShared::Offset).
-  for (std::size_t ci = 0; ci < ws.chain_count; ++ci) {
-    const std::uint32_t o = ws.offset_of[static_cast<std::size_t>(level - lb) * ws.chain_count + ci];
+  for (std::size_t ci = 0; ci < sh.chain_count; ++ci) {
+    const std::uint32_t o = sh.offset_of[static_cast<std::size_t>(level - sh.lb) * sh.chain_count + ci];
     if (o == kNoChain) continue;  // (the offset itself may still be in the making)
     ls.chain_offset[ci] = o;
     ls.paths.emplace_back();
     ls.box.push_back(sh.offsets[o].box);
-    ls.id.push_back(ws.chains[ci].id);
+    ls.id.push_back(sh.chains[ci].id);
     ls.chain.push_back(o);
     ls.all.add(sh.offsets[o].box);
   }
   // Turning moves: the union of their revolved regions on this level is one region, the
   // smallest r_min (external) and the largest r_max (internal); it takes the latest move id
   // among them.
-  if (!ws.lathe.empty()) {
+  if (!sh.lathe.empty()) {
     double r_out = INFINITY, r_in = -INFINITY, tol = spec_.chord_tol_mm;
     MoveId id_out = 0, id_in = 0;
-    for (std::size_t si = 0; si < ws.lathe.size(); ++si) {
-      const LatheSweep& lw = ws.lathe[si];
+    for (std::size_t si = 0; si < sh.lathe.size(); ++si) {
+      const LatheSweep& lw = sh.lathe[si];
       double lo = 0, hi = 0;
       if (zc < lw.z_min() || zc > lw.z_max() || !lw.interval(zc, lo, hi)) continue;
       tol = lw.chord_tol_mm();
       if (lw.internal()) {
         if (hi > r_in) r_in = hi;
-        id_in = std::max(id_in, ws.lathe_id[si]);
+        id_in = std::max(id_in, sh.lathe_id[si]);
       } else {
         if (lo < r_out) r_out = lo;
-        id_out = std::max(id_out, ws.lathe_id[si]);
+        id_out = std::max(id_out, sh.lathe_id[si]);
       }
     }
     for (int internal = 0; internal < 2; ++internal) {
@@ -681,8 +667,47 @@ void LbrSolid::build_level(int level, int lb, const SubtractShared& sh, Subtract
   ls.iy1 = interval_of(ys_, ls.all.y1);
 }
 
+// The chain offset `o` cut to `region` (grown by 1 mm); the first thread that needs a piece
+// cuts it, one that needs it meanwhile waits (a cut takes microseconds).
+const Paths& LbrSolid::offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const {
+  static const Paths kNone;
+  SubtractShared::Offset& off = sh.offsets[o];
+  const int ix = region % spec_.regions_x, iy = region / spec_.regions_x;
+  // A cell can touch the box on its edge from the region beside the box's first one: the
+  // offset covers none of its area there.
+  if (ix < off.ix0 || ix > off.ix1 || iy < off.iy0 || iy > off.iy1) return kNone;
+  const std::size_t i = static_cast<std::size_t>((iy - off.iy0) * (off.ix1 - off.ix0 + 1) + (ix - off.ix0));
+  std::atomic_ref<std::uint8_t> state(off.state[i]);
+  std::uint8_t s = state.load(std::memory_order_acquire);
+  if (s == 0 && state.compare_exchange_strong(s, 1, std::memory_order_acq_rel)) {
+    Rect rr = region_rect(region);
+    const Coord grow = static_cast<Coord>(kUnitsPerMm);
+    rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
+    Paths& out = off.cut[i];
+    out.clear();
+    if (off.box.x0 >= rr.x0 && off.box.x1 <= rr.x1 && off.box.y0 >= rr.y0 && off.box.y1 <= rr.y1) {
+      off.whole[i] = 1;  // wholly inside: nothing to cut
+    } else {
+      off.whole[i] = 0;
+      ClipperLib::Clipper& k = ws.rect_clipper;
+      k.Clear();
+      k.AddPaths(off.paths, ClipperLib::ptSubject, true);
+      k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
+      k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+    }
+    state.store(2, std::memory_order_release);
+  } else {
+    while (state.load(std::memory_order_acquire) != 2) {
+#if defined(__x86_64__) || defined(__i386__)
+      __builtin_ia32_pause();
+#endif
+    }
+  }
+  return off.whole[i] != 0 ? off.paths : off.cut[i];
+}
+
 // Clips one cell with the level's sections; true when the cell changed.
-bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, const SubtractShared& sh, SubtractWorkspace& ws,
+bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                          SubtractStats& stats) {
   const std::size_t ci = static_cast<std::size_t>(region) * levels_ + level;
   Cell& cell = cells_[ci];
@@ -743,8 +768,7 @@ bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, const S
     if (ls.chain[k] == kNoChain) {
       c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
     } else {
-      c.AddPaths(sh.offsets[ls.chain[k]].piece(region % spec_.regions_x, region / spec_.regions_x), ClipperLib::ptClip,
-                 true);
+      c.AddPaths(offset_piece(sh, ls.chain[k], region, ws), ClipperLib::ptClip, true);
     }
   }
   ws.tree.Clear();

@@ -1,6 +1,7 @@
 // app/level_pool.hpp — batch-mode worker pool: one subtract() spread over threads by level.
 //
-// Levels are independent in the LBR: the threads run LbrSolid::subtract_shared() together,
+// Levels are independent in the LBR: the calling thread prepares the batch
+// (LbrSolid::prepare_shared()), then the threads run LbrSolid::subtract_shared() together,
 // each with its own SubtractWorkspace (levels' sections, then the clips, taken from shared
 // counters; runs of equal levels are clipped once). The calling thread is worker 0.
 // Used by the offline runner only; the live geometry thread subtracts on its own.
@@ -33,8 +34,12 @@ class LevelPool {
   LevelPool& operator=(const LevelPool&) = delete;
 
   [[nodiscard]] int threads() const noexcept { return static_cast<int>(workspaces_.size()); }
-  // Same result as solid.subtract(batch). Blocks until every worker is done.
-  geom::SubtractStats subtract(geom::LbrSolid& solid, std::span<const geom::SweepRef> batch);
+  // Same result as solid.subtract(batch). Blocks until every worker is done. `next`, when
+  // given, is the batch of the following call (on the same solid): its chain offsets are
+  // built during this call, where a thread would otherwise wait (the result is the same;
+  // a following call with another batch just prepares that one).
+  geom::SubtractStats subtract(geom::LbrSolid& solid, std::span<const geom::SweepRef> batch,
+                               std::span<const geom::SweepRef> next = {});
 
  private:
   void worker(int index);
@@ -42,7 +47,11 @@ class LevelPool {
   void barrier() noexcept;  // spinning barrier over all threads (then yields)
 
   std::vector<std::unique_ptr<geom::SubtractWorkspace>> workspaces_;
-  geom::SubtractShared shared_;
+  geom::SubtractShared shared_[2];  // the current batch's and the next one's
+  int cur_ = 0;                      // index of the current batch's in shared_
+  std::vector<geom::SweepRef> ahead_batch_;  // the batch prepared in shared_[1 - cur_]
+  bool ahead_valid_ = false;
+  geom::SubtractShared* ahead_ = nullptr;    // published by generation_, like solid_
   std::function<void()> sync_;
   std::atomic<int> arrived_{0};
   std::atomic<unsigned> phase_{0};
@@ -50,8 +59,7 @@ class LevelPool {
   std::vector<std::thread> threads_;
   std::mutex m_;
   std::condition_variable start_, done_;
-  geom::LbrSolid* solid_ = nullptr;            // published by generation_ (release/acquire)
-  std::span<const geom::SweepRef> batch_;
+  geom::LbrSolid* solid_ = nullptr;  // with shared_[cur_], published by generation_ (release/acquire)
   std::atomic<unsigned long> generation_{0};
   std::atomic<int> pending_{0};
   std::atomic<bool> stop_{false};

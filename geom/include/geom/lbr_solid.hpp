@@ -88,11 +88,12 @@ struct SubtractStats {
   std::uint64_t sections_trimmed = 0;  // sections trimmed or dropped inside the previous one
   std::uint64_t cells_reused = 0;      // cells that took the result of the level below
   std::uint64_t sections_in_air = 0;   // (cell, section) pairs left out: no material there
+  std::uint64_t chain_offsets = 0;     // chain offsets built (LevelPool: some for the next batch)
   SubtractStats& operator+=(const SubtractStats& o) noexcept {
     sections += o.sections; cells_tested += o.cells_tested;
     cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
     sections_trimmed += o.sections_trimmed; cells_reused += o.cells_reused;
-    sections_in_air += o.sections_in_air;
+    sections_in_air += o.sections_in_air; chain_offsets += o.chain_offsets;
     return *this;
   }
 };
@@ -112,34 +113,12 @@ struct LevelSections {
   [[nodiscard]] bool empty() const noexcept { return ix1 < ix0 || iy1 < iy0; }
 };
 
-// State that the threads of one subtract_shared() call share: written in one phase, read
-// in the next (the caller's barrier orders them).
+// State that the threads of one subtract_shared() call share. prepare_shared() fills the
+// batch part on one thread; in subtract_shared() each part is written in one phase and read
+// in the next (the caller's barrier orders them), except the offsets' region pieces, which
+// the first clip that needs one cuts (a per-piece state orders it).
 struct SubtractShared {
-  std::vector<LevelSections> levels;    // per level the batch reaches, reused between batches
-  std::vector<std::uint8_t> outcome;    // per (level - lb, region): the clip changed the cell
-  // A chain offset by one radius (one per distinct (chain, radius) of the batch), and its
-  // pieces cut to the regions its box reaches (rectangles grown by 1 mm), so that a clip
-  // carries only the nearby edges.
-  struct Offset {
-    Paths paths;
-    Rect box;
-    int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;
-    std::vector<Paths> cut;  // (iy - iy0) * (ix1 - ix0 + 1) + (ix - ix0)
-    [[nodiscard]] const Paths& piece(int ix, int iy) const {
-      return cut[static_cast<std::size_t>((iy - iy0) * (ix1 - ix0 + 1) + (ix - ix0))];
-    }
-  };
-  std::vector<Offset> offsets;
-  std::atomic<std::size_t> next[3] = {};  // work counters of the phases
-};
-
-// Reusable buffers for subtract(); one per thread that calls it. Grows to the largest batch
-// seen and is then reused without further allocation of its own.
-struct SubtractWorkspace {
-  ClipperLib::Clipper clipper;
-  ClipperLib::Clipper rect_clipper;  // cuts chain offsets to regions
-  ClipperLib::PolyTree tree;
-  SectionScratch scratch;
+  // --- the batch, prepared once (read only while the threads run) ---
   std::vector<SweepRef> merged;   // the batch after merging collinear runs
   std::vector<Sweep> sweeps;      // one per merged milling move
   std::vector<MoveId> sweep_id;   // their move ids
@@ -156,14 +135,42 @@ struct SubtractWorkspace {
   };
   std::vector<Chain> chains;
   std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
-  std::vector<std::uint8_t> trim_flags;
-  std::vector<int> source;          // per (level - lb, region): the level whose result it takes
   struct OffsetKey {
     std::uint32_t chain;
     double r;
   };
   std::vector<OffsetKey> offset_keys;      // the batch's distinct (chain, radius), in order
   std::vector<std::uint32_t> offset_of;    // per (level - lb, chain): index into offset_keys, or ~0
+  int lb = 0, le = 0;                      // the levels the batch reaches: [lb, le)
+  bool offsets_ready = false;              // the offsets' paths are built (during the batch before)
+
+  // --- built by the threads ---
+  std::vector<LevelSections> levels;    // per level the batch reaches, reused between batches
+  std::vector<std::uint8_t> outcome;    // per (level - lb, region): the clip changed the cell
+  // A chain offset by one radius (one per distinct (chain, radius) of the batch), and its
+  // pieces cut to the regions its box reaches (rectangles grown by 1 mm), so that a clip
+  // carries only the nearby edges. A piece is cut when a clip first needs it.
+  struct Offset {
+    Paths paths;
+    Rect box;
+    int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;
+    std::vector<Paths> cut;            // (iy - iy0) * (ix1 - ix0 + 1) + (ix - ix0)
+    std::vector<std::uint8_t> state;   // per piece: 0 not cut, 1 being cut, 2 cut (atomic_ref)
+    std::vector<std::uint8_t> whole;   // per piece: the offset lies inside it, uncut
+  };
+  std::vector<Offset> offsets;
+  std::atomic<std::size_t> next[2] = {};  // work counters of the phases
+};
+
+// Reusable buffers for subtract(); one per thread that calls it. Grows to the largest batch
+// seen and is then reused without further allocation of its own.
+struct SubtractWorkspace {
+  ClipperLib::Clipper clipper;
+  ClipperLib::Clipper rect_clipper;  // cuts chain offsets to regions
+  ClipperLib::PolyTree tree;
+  SectionScratch scratch;
+  std::vector<std::uint8_t> trim_flags;
+  std::vector<int> source;          // per (level - lb, region): the level whose result it takes
   std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip
   std::vector<std::pair<std::size_t, std::uint32_t>> job_cost;  // (estimate, job) for ordering
   SubtractShared own;               // for subtract() on one thread
@@ -187,16 +194,23 @@ class LbrSolid {
   // dirty. Does not throw; allocates (Clipper does).
   SubtractStats subtract(std::span<const SweepRef> batch);
   SubtractStats subtract(std::span<const SweepRef> batch, SubtractWorkspace& ws);
-  // The same subtraction run by `count` threads together: each calls it with its own
-  // workspace and its index in [0, count), the same batch and the same `shared`; `sync` is a
-  // barrier over the `count` callers (called four times). Each returns its share of the
-  // statistics. Phases: every thread prepares the batch (merging, sweeps, chains); the
-  // chain offsets and the levels' sections are built and compared with the level below;
-  // then the cells that start a run of equal levels are clipped (longest first), and the
-  // rest of each run copies its result (vertical coherence). Work inside a phase is taken
-  // from shared counters. The result does not depend on `count`.
-  SubtractStats subtract_shared(std::span<const SweepRef> batch, SubtractShared& shared, SubtractWorkspace& ws,
-                                int index, int count, const std::function<void()>& sync);
+  // The same subtraction run by `count` threads together. One thread first calls
+  // prepare_shared() (merging, sweeps, chains, shared storage); then each of the `count`
+  // threads calls subtract_shared() with its own workspace, its index in [0, count) and the
+  // same `shared`; `sync` is a barrier over the `count` callers (called twice, or never when
+  // the batch reaches no level). Each returns its share of the statistics. Phases: the chain
+  // offsets and the levels' sections are built, and each cell compared with the one below;
+  // then the cells that start a run of equal levels are clipped (longest first; offsets are
+  // cut to a region when a clip first needs it), and the rest of each run copies its result
+  // (vertical coherence). Work inside a phase is taken from shared counters. The result
+  // does not depend on `count`.
+  //
+  // `ahead`, when given, is the next batch, prepared by prepare_shared(): its chain offsets
+  // (which depend on the batch only) are built among this batch's clips, where a thread
+  // would otherwise wait for the longest of them; the caller then sets its offsets_ready.
+  void prepare_shared(std::span<const SweepRef> batch, SubtractShared& shared) const;
+  SubtractStats subtract_shared(SubtractShared& shared, SubtractWorkspace& ws, int index, int count,
+                                const std::function<void()>& sync, SubtractShared* ahead = nullptr);
 
   // 3D boolean difference with another LBR solid (the paper's OpBool): every level of this
   // solid loses the polygons of the other solid's level that contains the same mid-plane
@@ -254,10 +268,10 @@ class LbrSolid {
  private:
   void init_cells();
   // Phases of subtract_shared().
-  double prepare(std::span<const SweepRef> batch, SubtractWorkspace& ws, double& zhi) const;
-  void build_level(int level, int lb, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& out,
+  void build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& out,
                    SubtractStats& stats) const;
-  bool clip_cell(int region, int level, const LevelSections& ls, const SubtractShared& sh, SubtractWorkspace& ws,
+  const Paths& offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const;
+  bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                  SubtractStats& stats);
 
   SolidSpec spec_;
