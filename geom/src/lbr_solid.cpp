@@ -438,6 +438,7 @@ void LbrSolid::prepare_shared(std::span<const SweepRef> batch, SubtractShared& s
     off.whole.assign(pieces, 0);
   }
   for (auto& next : sh.next) next.store(0, std::memory_order_relaxed);
+  sh.ahead_ready.store(0, std::memory_order_relaxed);
   sh.offsets_ready = false;
 }
 
@@ -459,19 +460,56 @@ void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
 }  // namespace
 
 SubtractStats LbrSolid::subtract_shared(SubtractShared& sh, SubtractWorkspace& ws, int index, int count,
-                                        const std::function<void()>& sync, SubtractShared* ahead) {
+                                        const std::function<void()>& sync, const SubtractAhead* ahead) {
   SubtractStats stats;
   const int lb = sh.lb, le = sh.le, n = le - lb;
   // Work is taken from shared counters, so a thread that gets a long item takes fewer of
   // the rest; which thread does an item never changes the result.
   auto take = [&](int phase) { return sh.next[static_cast<std::size_t>(phase)].fetch_add(1, std::memory_order_relaxed); };
-  // Phase C's first items: the next batch's offsets.
-  const std::size_t pre = ahead != nullptr ? ahead->offset_keys.size() : 0;
+  const std::size_t nreg = static_cast<std::size_t>(regions());
+  // Phase C's items: the next batch's preparation (item 0, when there is one), then the
+  // cells to clip; once it is prepared, its offsets go before the clips.
+  const std::size_t pre = ahead != nullptr ? 1 : 0;
+  auto ahead_offset = [&] {
+    if (ahead == nullptr || sh.ahead_ready.load(std::memory_order_acquire) == 0) return false;
+    const std::size_t o = take(2);
+    if (o >= ahead->shared->offset_keys.size()) return false;
+    build_offset(*ahead->shared, o, stats);
+    return true;
+  };
+  auto run_phase_c = [&](const std::vector<std::uint32_t>& jobs) {
+    for (;;) {
+      if (ahead_offset()) continue;
+      const std::size_t item = take(1);
+      if (item < pre) {
+        ahead->prepare();
+        sh.ahead_ready.store(1, std::memory_order_release);
+        continue;
+      }
+      if (item - pre < jobs.size()) {
+        const std::size_t k = jobs[item - pre];
+        const int l = lb + static_cast<int>(k / nreg), region = static_cast<int>(k % nreg);
+        sh.outcome[k] = clip_cell(region, l, sh.levels[k / nreg], sh, ws, stats) ? 1 : 0;
+        continue;
+      }
+      // No clips left: the next batch's offsets, once it is prepared.
+      if (ahead != nullptr) {
+        while (sh.ahead_ready.load(std::memory_order_acquire) == 0) {
+#if defined(__x86_64__) || defined(__i386__)
+          __builtin_ia32_pause();
+#endif
+        }
+        while (ahead_offset()) {
+        }
+      }
+      return;
+    }
+  };
   if (n <= 0) {  // the same in every thread: nobody waits
-    for (std::size_t item = take(1); item < pre; item = take(1)) build_offset(*ahead, item, stats);
+    ws.jobs.clear();
+    run_phase_c(ws.jobs);
     return stats;
   }
-  const std::size_t nreg = static_cast<std::size_t>(regions());
   const std::size_t noff = sh.offsets_ready ? 0 : sh.offset_keys.size();
   // Phase A: the chain offsets unless built ahead (items [0, noff)) and the levels'
   // sections (the rest); for the cells a level reaches, whether the cell starts equal to
@@ -537,15 +575,7 @@ SubtractStats LbrSolid::subtract_shared(SubtractShared& sh, SubtractWorkspace& w
     });
     for (std::size_t j = 0; j < ws.jobs.size(); ++j) ws.jobs[j] = ws.job_cost[j].second;
   }
-  for (std::size_t item = take(1); item < pre + ws.jobs.size(); item = take(1)) {
-    if (item < pre) {
-      build_offset(*ahead, item, stats);
-      continue;
-    }
-    const std::size_t k = ws.jobs[item - pre];
-    const int l = lb + static_cast<int>(k / nreg), region = static_cast<int>(k % nreg);
-    sh.outcome[k] = clip_cell(region, l, sh.levels[k / nreg], sh, ws, stats) ? 1 : 0;
-  }
+  run_phase_c(ws.jobs);
   sync();  // (2) every run's first cell is final
   // Phase D: the other cells of each run take its result.
   std::size_t copy = 0;

@@ -12,6 +12,8 @@
 // someone actually sleeps.
 #pragma once
 
+#include <sched.h>
+
 #include <atomic>
 #include <condition_variable>
 #include <functional>
@@ -51,7 +53,9 @@ class LevelPool {
   int cur_ = 0;                      // index of the current batch's in shared_
   std::vector<geom::SweepRef> ahead_batch_;  // the batch prepared in shared_[1 - cur_]
   bool ahead_valid_ = false;
-  geom::SubtractShared* ahead_ = nullptr;    // published by generation_, like solid_
+  std::span<const geom::SweepRef> next_;     // the next batch, for ahead_.prepare
+  geom::SubtractAhead ahead_;                // its preparation (shared_[1 - cur_])
+  const geom::SubtractAhead* ahead_ptr_ = nullptr;  // &ahead_ or none; published like solid_
   std::function<void()> sync_;
   std::atomic<int> arrived_{0};
   std::atomic<unsigned> phase_{0};
@@ -62,6 +66,9 @@ class LevelPool {
   geom::LbrSolid* solid_ = nullptr;  // with shared_[cur_], published by generation_ (release/acquire)
   std::atomic<unsigned long> generation_{0};
   std::atomic<int> pending_{0};
+  std::atomic<int> started_{0};  // workers running
+  cpu_set_t allowed_{};          // the process's processors, when have_mask_
+  bool have_mask_ = false;
   std::atomic<bool> stop_{false};
   int sleepers_ = 0;          // workers blocked on start_ (guarded by m_)
   bool caller_waiting_ = false;  // the caller blocked on done_ (guarded by m_)

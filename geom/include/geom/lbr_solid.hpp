@@ -159,7 +159,17 @@ struct SubtractShared {
     std::vector<std::uint8_t> whole;   // per piece: the offset lies inside it, uncut
   };
   std::vector<Offset> offsets;
-  std::atomic<std::size_t> next[2] = {};  // work counters of the phases
+  std::atomic<std::size_t> next[3] = {};  // work counters: phase A, phase C, next batch's offsets
+  std::atomic<std::uint8_t> ahead_ready{0};  // the next batch is prepared (SubtractAhead)
+};
+
+// The batch after the current one, prepared during the current one's clips by one thread
+// (`prepare`: prepare_shared() into `shared`, and whatever the caller keeps with it); its
+// chain offsets, which depend on the batch only, are then built by the threads between
+// their clips. The caller sets shared->offsets_ready once the call has returned.
+struct SubtractAhead {
+  SubtractShared* shared = nullptr;
+  std::function<void()> prepare;
 };
 
 // Reusable buffers for subtract(); one per thread that calls it. Grows to the largest batch
@@ -205,12 +215,12 @@ class LbrSolid {
   // (vertical coherence). Work inside a phase is taken from shared counters. The result
   // does not depend on `count`.
   //
-  // `ahead`, when given, is the next batch, prepared by prepare_shared(): its chain offsets
-  // (which depend on the batch only) are built among this batch's clips, where a thread
-  // would otherwise wait for the longest of them; the caller then sets its offsets_ready.
+  // `ahead`, when given, is the next batch (SubtractAhead): it is prepared and its chain
+  // offsets built among this batch's clips, where a thread would otherwise wait for the
+  // longest offset at the start of the next batch, and the caller for the preparation.
   void prepare_shared(std::span<const SweepRef> batch, SubtractShared& shared) const;
   SubtractStats subtract_shared(SubtractShared& shared, SubtractWorkspace& ws, int index, int count,
-                                const std::function<void()>& sync, SubtractShared* ahead = nullptr);
+                                const std::function<void()>& sync, const SubtractAhead* ahead = nullptr);
 
   // 3D boolean difference with another LBR solid (the paper's OpBool): every level of this
   // solid loses the polygons of the other solid's level that contains the same mid-plane
