@@ -1,4 +1,4 @@
-// LevelPool: the threaded subtraction, with and without the next batch given ahead, gives
+// LevelPool: the threaded subtraction, batch by batch or pulling batches one ahead, gives
 // the single-threaded solid byte for byte, and builds each chain offset once.
 #include <gtest/gtest.h>
 
@@ -50,40 +50,58 @@ geom::SolidSpec spec() {
   return s;
 }
 
-TEST(LevelPool, NextBatchAheadGivesTheSameSolidAndBuildsEachOffsetOnce) {
+// The pool's run() over the batches (pulled one ahead by a worker) and its subtract() per
+// batch, with 1 to 3 threads.
+TEST(LevelPool, RunGivesTheSingleThreadedSolidAndBuildsEachOffsetOnce) {
   const geom::CutterShape tool = geom::CutterShape::build(test::tool(geom::ToolKind::Flat, 8.0), 0.005);
-  const auto batches = pocket_batches(tool, 24);
-  ASSERT_GT(batches.size(), 4u);
+  auto batches = pocket_batches(tool, 24);
+  batches.insert(batches.begin() + 3, std::vector<SweepRef>{});  // an empty batch on the way
+  ASSERT_GT(batches.size(), 5u);
 
   geom::LbrSolid one(spec());
   geom::SubtractStats s1;
   for (const auto& b : batches) s1 += one.subtract(b);
   ASSERT_GT(s1.chain_offsets, 2u);
+  ASSERT_GT(s1.cells_changed, 0u);
 
-  for (int threads : {2, 3}) {
-    // With the right next batch: the same bytes, the same offsets (built a batch early).
+  for (int threads : {1, 2, 3}) {
     geom::LbrSolid many(spec());
     app::LevelPool pool(threads);
-    geom::SubtractStats s;
-    for (std::size_t i = 0; i < batches.size(); ++i)
-      s += pool.subtract(many, batches[i], i + 1 < batches.size() ? std::span<const SweepRef>(batches[i + 1])
-                                                                   : std::span<const SweepRef>());
+    std::size_t next = 0, pulled = 0, done = 0;
+    geom::SubtractStats each;
+    const geom::SubtractStats s = pool.run(
+        many,
+        [&](std::vector<SweepRef>& out) {
+          if (next == batches.size()) return false;
+          out = batches[next++];
+          ++pulled;
+          return true;
+        },
+        [&](const geom::SubtractStats& b) {
+          ++done;
+          each += b;
+        });
+    EXPECT_EQ(pulled, batches.size()) << threads;
+    EXPECT_EQ(done, batches.size()) << threads;
     EXPECT_EQ(geom::to_bytes(one), geom::to_bytes(many)) << threads;
-    EXPECT_EQ(s.chain_offsets, s1.chain_offsets) << threads;
+    EXPECT_EQ(s.chain_offsets, s1.chain_offsets) << threads;  // each once, most a batch early
     EXPECT_EQ(s.cells_clipped, s1.cells_clipped) << threads;
     EXPECT_EQ(s.cells_reused, s1.cells_reused) << threads;
+    EXPECT_EQ(each.cells_changed, s.cells_changed) << threads;
 
-    // With a wrong next batch (the one after it): still the same bytes; the offsets built
-    // ahead for batches that did not come are wasted, so more are built in all.
-    geom::LbrSolid wrong(spec());
-    app::LevelPool pool2(threads);
-    geom::SubtractStats w;
-    for (std::size_t i = 0; i < batches.size(); ++i)
-      w += pool2.subtract(wrong, batches[i], i + 2 < batches.size() ? std::span<const SweepRef>(batches[i + 2])
-                                                                     : std::span<const SweepRef>());
-    EXPECT_EQ(geom::to_bytes(one), geom::to_bytes(wrong)) << threads;
-    EXPECT_GT(w.chain_offsets, s1.chain_offsets) << threads;
-    EXPECT_EQ(w.cells_clipped, s1.cells_clipped) << threads;
+    // subtract() per batch on the same pool, then run() again on a fresh solid: the pool
+    // holds no state between calls that changes the result.
+    geom::LbrSolid again(spec());
+    for (const auto& b : batches) (void)pool.subtract(again, b);
+    EXPECT_EQ(geom::to_bytes(one), geom::to_bytes(again)) << threads;
+    geom::LbrSolid third(spec());
+    next = 0;
+    (void)pool.run(third, [&](std::vector<SweepRef>& out) {
+      if (next == batches.size()) return false;
+      out = batches[next++];
+      return true;
+    });
+    EXPECT_EQ(geom::to_bytes(one), geom::to_bytes(third)) << threads;
   }
 }
 

@@ -169,33 +169,41 @@ void run_moves(const Profile& profile, const std::vector<TimedMove>& moves, Batc
   // removed), so a batch is grouped by channel: each channel's consecutive sampled moves
   // then merge into long sweeps (merge_collinear) instead of alternating with the others'.
   std::vector<const TimedMove*> group;
-  auto fill = [&](std::size_t begin, std::size_t end, std::vector<geom::SweepRef>& out) {
+  auto fill = [&](std::size_t from, std::size_t to, std::vector<geom::SweepRef>& out) {
+    out.clear();
+    const auto by_channel = [](const TimedMove& a, const TimedMove& b) { return a.channel < b.channel; };
+    if (std::is_sorted(moves.begin() + static_cast<long>(from), moves.begin() + static_cast<long>(to), by_channel)) {
+      for (std::size_t k = from; k < to; ++k) out.push_back(moves[k].ref);  // one channel: as they come
+      return;
+    }
     group.clear();
-    for (std::size_t k = begin; k < end; ++k) group.push_back(&moves[k]);
+    for (std::size_t k = from; k < to; ++k) group.push_back(&moves[k]);
     std::stable_sort(group.begin(), group.end(),
                      [](const TimedMove* a, const TimedMove* b) { return a->channel < b->channel; });
-    out.clear();
     for (const TimedMove* m : group) out.push_back(m->ref);
   };
-  // Batches of profile.batch_moves moves; the pool gets the next one too (LevelPool::subtract).
+  // Batches of profile.batch_moves moves, pulled by the pool (a worker pulls the next one
+  // while the current one is clipped).
   const std::size_t per = static_cast<std::size_t>(std::max(1, profile.batch_moves));
-  std::vector<geom::SweepRef> batch[2];
-  if (!moves.empty()) fill(0, std::min(per, moves.size()), batch[0]);
-  for (std::size_t begin = 0, k = 0; begin < moves.size(); begin += per, ++k) {
-    const std::size_t next = begin + per;
-    std::vector<geom::SweepRef>& now = batch[k % 2];
-    std::vector<geom::SweepRef>& ahead = batch[(k + 1) % 2];
-    ahead.clear();
-    if (next < moves.size()) fill(next, std::min(next + per, moves.size()), ahead);
-    if (!now.empty()) r.stats += pool.subtract(r.solid, now, ahead);
-    if (progress) {
-      const auto now_t = std::chrono::steady_clock::now();
-      if (now_t - last_report > std::chrono::seconds(1)) {
-        last_report = now_t;
-        progress(static_cast<double>(std::min(next, moves.size())) / static_cast<double>(moves.size()));
-      }
+  std::size_t begin = 0;
+  const LevelPool::BatchSource source = [&](std::vector<geom::SweepRef>& out) {
+    if (begin >= moves.size()) return false;
+    const std::size_t end = std::min(begin + per, moves.size());
+    fill(begin, end, out);
+    begin = end;
+    return true;
+  };
+  std::size_t done_moves = 0;
+  const LevelPool::BatchDone done = [&](const geom::SubtractStats&) {
+    done_moves = std::min(done_moves + per, moves.size());
+    if (!progress) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_report > std::chrono::seconds(1)) {
+      last_report = now;
+      progress(static_cast<double>(done_moves) / static_cast<double>(moves.size()));
     }
-  }
+  };
+  r.stats += pool.run(r.solid, source, done);
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.removed_volume_mm3 = r.stock_volume_mm3 - r.solid.volume_mm3();
   if (progress) progress(1.0);

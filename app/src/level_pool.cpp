@@ -14,16 +14,6 @@ namespace {
 // the offline runner, far shorter than a scheduler tick.
 constexpr auto kSpin = std::chrono::microseconds(200);
 
-bool same_batch(std::span<const geom::SweepRef> a, std::span<const geom::SweepRef> b) noexcept {
-  auto pose = [](const geom::Pose& p, const geom::Pose& q) {
-    return p.tip.x == q.tip.x && p.tip.y == q.tip.y && p.tip.z == q.tip.z && p.axis.x == q.axis.x &&
-           p.axis.y == q.axis.y && p.axis.z == q.axis.z;
-  };
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [&](const geom::SweepRef& x, const geom::SweepRef& y) {
-    return x.shape == y.shape && x.turning == y.turning && x.id == y.id && pose(x.from, y.from) && pose(x.to, y.to);
-  });
-}
-
 inline void relax() noexcept {
 #if defined(__x86_64__) || defined(__i386__)
   __builtin_ia32_pause();
@@ -49,8 +39,11 @@ LevelPool::LevelPool(int threads) {
   results_.resize(workspaces_.size());
   sync_ = [this] { barrier(); };
   ahead_.prepare = [this] {
-    ahead_batch_.assign(next_.begin(), next_.end());
-    solid_->prepare_shared(next_, *ahead_.shared);
+    std::vector<geom::SweepRef>& next = batches_[1 - cur_];
+    next.clear();
+    ahead_more_ = (*source_)(next);
+    if (!ahead_more_) next.clear();
+    solid_->prepare_shared(next, *ahead_.shared);  // (empty: nothing to cut, no offsets)
   };
   // A new thread starts on its creator's processor, and this one stays busy: measured on a
   // two-core machine, a worker that started beside the caller stayed there for whole runs
@@ -122,19 +115,45 @@ void LevelPool::worker(int index) {
   }
 }
 
-geom::SubtractStats LevelPool::subtract(geom::LbrSolid& solid, std::span<const geom::SweepRef> batch,
-                                        std::span<const geom::SweepRef> next) {
+geom::SubtractStats LevelPool::subtract(geom::LbrSolid& solid, std::span<const geom::SweepRef> batch) {
   if (threads_.empty()) return solid.subtract(batch, *workspaces_[0]);
-  // Prepared before the workers start (they only read it): this batch, unless the call
-  // before prepared it as its `next` for this solid, and the next one.
-  if (ahead_valid_ && solid_ == &solid && same_batch(batch, ahead_batch_)) cur_ = 1 - cur_;
-  else solid.prepare_shared(batch, shared_[cur_]);
+  solid.prepare_shared(batch, shared_[cur_]);  // before the workers start: they only read it
+  ahead_ptr_ = nullptr;
+  return dispatch(solid);
+}
+
+geom::SubtractStats LevelPool::run(geom::LbrSolid& solid, const BatchSource& source, const BatchDone& done) {
+  geom::SubtractStats total;
+  if (threads_.empty()) {
+    std::vector<geom::SweepRef>& batch = batches_[0];
+    for (batch.clear(); source(batch); batch.clear()) {
+      const geom::SubtractStats s = solid.subtract(batch, *workspaces_[0]);
+      total += s;
+      if (done) done(s);
+    }
+    return total;
+  }
+  source_ = &source;
+  batches_[cur_].clear();
+  if (!source(batches_[cur_])) return total;
+  solid.prepare_shared(batches_[cur_], shared_[cur_]);
+  for (;;) {
+    ahead_.shared = &shared_[1 - cur_];
+    ahead_ptr_ = &ahead_;
+    const geom::SubtractStats s = dispatch(solid);
+    total += s;
+    if (done) done(s);
+    if (!ahead_more_) break;
+    shared_[1 - cur_].offsets_ready = true;  // built among this batch's clips
+    cur_ = 1 - cur_;
+  }
+  source_ = nullptr;
+  ahead_ptr_ = nullptr;
+  return total;
+}
+
+geom::SubtractStats LevelPool::dispatch(geom::LbrSolid& solid) {
   solid_ = &solid;
-  // The next batch is prepared by a worker among this batch's clips.
-  ahead_valid_ = !next.empty();
-  next_ = next;
-  ahead_.shared = &shared_[1 - cur_];
-  ahead_ptr_ = ahead_valid_ ? &ahead_ : nullptr;
   pending_.store(static_cast<int>(threads_.size()), std::memory_order_relaxed);
   {
     std::lock_guard lk(m_);
@@ -149,7 +168,6 @@ geom::SubtractStats LevelPool::subtract(geom::LbrSolid& solid, std::span<const g
     done_.wait(lk, done);
     caller_waiting_ = false;
   }
-  if (ahead_valid_) ahead_.shared->offsets_ready = true;  // every worker is done
   geom::SubtractStats total;
   for (const auto& r : results_) total += r;
   return total;

@@ -36,25 +36,35 @@ class LevelPool {
   LevelPool& operator=(const LevelPool&) = delete;
 
   [[nodiscard]] int threads() const noexcept { return static_cast<int>(workspaces_.size()); }
-  // Same result as solid.subtract(batch). Blocks until every worker is done. `next`, when
-  // given, is the batch of the following call (on the same solid): its chain offsets are
-  // built during this call, where a thread would otherwise wait (the result is the same;
-  // a following call with another batch just prepares that one).
-  geom::SubtractStats subtract(geom::LbrSolid& solid, std::span<const geom::SweepRef> batch,
-                               std::span<const geom::SweepRef> next = {});
+  // Same result as solid.subtract(batch). Blocks until every worker is done.
+  geom::SubtractStats subtract(geom::LbrSolid& solid, std::span<const geom::SweepRef> batch);
+
+  // Fills `out` with the next batch; false when there is none. Called on one thread at a
+  // time, in order, but not always the caller's: a worker pulls the next batch.
+  using BatchSource = std::function<bool(std::vector<geom::SweepRef>& out)>;
+  // Called on the calling thread after each batch, with its statistics.
+  using BatchDone = std::function<void(const geom::SubtractStats&)>;
+  // Subtracts the batches of `source` in order; the same result as solid.subtract() of each
+  // in turn. With workers, the next batch is pulled and prepared (merging, sweeps, chain
+  // offsets) among the current one's clips, so that neither the caller nor a worker waits
+  // for it between batches. Returns the total statistics.
+  geom::SubtractStats run(geom::LbrSolid& solid, const BatchSource& source, const BatchDone& done = {});
 
  private:
   void worker(int index);
+  geom::SubtractStats dispatch(geom::LbrSolid& solid);  // runs shared_[cur_] on all threads
 
   void barrier() noexcept;  // spinning barrier over all threads (then yields)
 
   std::vector<std::unique_ptr<geom::SubtractWorkspace>> workspaces_;
-  geom::SubtractShared shared_[2];  // the current batch's and the next one's
+  geom::SubtractShared shared_[2];  // the current batch's and, in run(), the next one's
   int cur_ = 0;                      // index of the current batch's in shared_
-  std::vector<geom::SweepRef> ahead_batch_;  // the batch prepared in shared_[1 - cur_]
-  bool ahead_valid_ = false;
-  std::span<const geom::SweepRef> next_;     // the next batch, for ahead_.prepare
-  geom::SubtractAhead ahead_;                // its preparation (shared_[1 - cur_])
+  // run(): the next batch, pulled from source_ and prepared into shared_[1 - cur_] by the
+  // worker that takes ahead_'s item; ahead_more_ says whether there was one.
+  const BatchSource* source_ = nullptr;
+  std::vector<geom::SweepRef> batches_[2];
+  bool ahead_more_ = false;
+  geom::SubtractAhead ahead_;
   const geom::SubtractAhead* ahead_ptr_ = nullptr;  // &ahead_ or none; published like solid_
   std::function<void()> sync_;
   std::atomic<int> arrived_{0};
