@@ -152,3 +152,33 @@ TEST(Solid, SectionsInTheAirLeaveTheDifference) {
   EXPECT_NEAR(v0 - s.volume_mm3(), area * 3.0, 2 * (40.0 + 10.0 * test::kPi) * 0.001 * 3.0);
   EXPECT_EQ(s.check_invariants(), "");
 }
+
+TEST(Solid, ChainOffsetBoxOnARegionBoundary) {
+  // A chain's offset box is its polyline's box grown by r + tol/4 (rounded up, +2 units).
+  // Here it starts exactly on the boundary x = 15 mm between regions 0 and 1 (and a few
+  // units either side), and a plunge in region 0 brings that region's cells into the batch:
+  // they touch the box on their edge, and their clip must not look for a piece of the
+  // offset there (it covers none of their area). The chained cut must remove what the same
+  // moves remove one by one (stadiums, no chain).
+  const auto flat = geom::CutterShape::build(test::tool(ToolKind::Flat, 8), 0.005);
+  const double d = (std::ceil((4.0 + 0.25 * 0.005) * geom::kUnitsPerMm) + 2.0) / geom::kUnitsPerMm;  // 4.0015 mm
+  for (int k = -3; k <= 3; ++k) {
+    const double x0 = 15.0 + d + k / geom::kUnitsPerMm;
+    std::vector<geom::SweepRef> moves{{&flat, test::at(7, 20, 12), test::at(7, 20, 5), 10, nullptr}};
+    const std::vector<geom::Pose> pts{test::at(x0, 5, 5), test::at(x0 + 8, 12, 5), test::at(x0, 19, 5),
+                                      test::at(x0 + 8, 26, 5), test::at(x0, 33, 5)};
+    for (std::size_t i = 1; i < pts.size(); ++i)
+      moves.push_back({&flat, pts[i - 1], pts[i], static_cast<geom::MoveId>(i), nullptr});
+    geom::LbrSolid chained(test::box_spec({0, 0, 0}, {60, 40, 10}, 0.5, 4, 2));
+    const geom::SubtractStats s = chained.subtract(moves);
+    geom::LbrSolid single(test::box_spec({0, 0, 0}, {60, 40, 10}, 0.5, 4, 2));
+    for (const geom::SweepRef& m : moves) (void)single.subtract(std::span<const geom::SweepRef>(&m, 1));
+    EXPECT_GT(s.chain_offsets, 0u) << k;
+    EXPECT_EQ(chained.check_invariants(), "") << k;
+    // Both boundaries lie within ±tol/2 of the exact one; the cut is 5 mm deep, its outline
+    // shorter than 2 x (4 x 10.6 + 8 pi) mm.
+    const double outline = 2.0 * (4.0 * 10.6 + 8.0 * test::kPi);
+    EXPECT_NEAR(chained.volume_mm3(), single.volume_mm3(), outline * 0.005 * 5.0) << k;
+    EXPECT_GT(chained.initial_volume_mm3() - chained.volume_mm3(), 5.0 * (10.6 * 8.0 + 32.0 * test::kPi)) << k;  // > a stadium and the hole
+  }
+}
