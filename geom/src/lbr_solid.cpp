@@ -23,6 +23,13 @@ void require(bool ok, const std::string& what) {
 
 bool in_range(double mm) { return std::isfinite(mm) && std::abs(mm) <= kSafeRangeMm; }
 
+// One step of a thread's wait for another's (a few microseconds at most).
+inline void cpu_relax() noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
 constexpr std::uint32_t kNoChain = 0xFFFFFFFFu;
 
 bool same_contour(const Contour& a, const Contour& b) noexcept { return a.cut_by == b.cut_by && a.pts == b.pts; }
@@ -435,7 +442,6 @@ void LbrSolid::prepare_shared(std::span<const SweepRef> batch, SubtractShared& s
     const std::size_t pieces = static_cast<std::size_t>((off.ix1 - off.ix0 + 1) * (off.iy1 - off.iy0 + 1));
     off.cut.resize(pieces);
     off.state.assign(pieces, 0);
-    off.whole.assign(pieces, 0);
   }
   for (auto& next : sh.next) next.store(0, std::memory_order_relaxed);
   sh.ahead_ready.store(0, std::memory_order_relaxed);
@@ -477,7 +483,8 @@ SubtractStats LbrSolid::subtract_shared(SubtractShared& sh, SubtractWorkspace& w
     build_offset(*ahead->shared, o, stats);
     return true;
   };
-  auto run_phase_c = [&](const std::vector<std::uint32_t>& jobs) {
+  auto run_phase_c = [&] {
+    const std::vector<std::uint32_t>& jobs = ws.jobs;
     for (;;) {
       if (ahead_offset()) continue;
       const std::size_t item = take(1);
@@ -494,11 +501,7 @@ SubtractStats LbrSolid::subtract_shared(SubtractShared& sh, SubtractWorkspace& w
       }
       // No clips left: the next batch's offsets, once it is prepared.
       if (ahead != nullptr) {
-        while (sh.ahead_ready.load(std::memory_order_acquire) == 0) {
-#if defined(__x86_64__) || defined(__i386__)
-          __builtin_ia32_pause();
-#endif
-        }
+        while (sh.ahead_ready.load(std::memory_order_acquire) == 0) cpu_relax();
         while (ahead_offset()) {
         }
       }
@@ -507,7 +510,7 @@ SubtractStats LbrSolid::subtract_shared(SubtractShared& sh, SubtractWorkspace& w
   };
   if (n <= 0) {  // the same in every thread: nobody waits
     ws.jobs.clear();
-    run_phase_c(ws.jobs);
+    run_phase_c();
     return stats;
   }
   const std::size_t noff = sh.offsets_ready ? 0 : sh.offset_keys.size();
@@ -575,7 +578,7 @@ SubtractStats LbrSolid::subtract_shared(SubtractShared& sh, SubtractWorkspace& w
     });
     for (std::size_t j = 0; j < ws.jobs.size(); ++j) ws.jobs[j] = ws.job_cost[j].second;
   }
-  run_phase_c(ws.jobs);
+  run_phase_c();
   sync();  // (2) every run's first cell is final
   // Phase D: the other cells of each run take its result.
   std::size_t copy = 0;
@@ -706,34 +709,27 @@ const Paths& LbrSolid::offset_piece(SubtractShared& sh, std::uint32_t o, int reg
   // A cell can touch the box on its edge from the region beside the box's first one: the
   // offset covers none of its area there.
   if (ix < off.ix0 || ix > off.ix1 || iy < off.iy0 || iy > off.iy1) return kNone;
+  Rect rr = region_rect(region);
+  const Coord grow = static_cast<Coord>(kUnitsPerMm);
+  rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
+  if (off.box.x0 >= rr.x0 && off.box.x1 <= rr.x1 && off.box.y0 >= rr.y0 && off.box.y1 <= rr.y1)
+    return off.paths;  // wholly inside: nothing to cut
   const std::size_t i = static_cast<std::size_t>((iy - off.iy0) * (off.ix1 - off.ix0 + 1) + (ix - off.ix0));
   std::atomic_ref<std::uint8_t> state(off.state[i]);
   std::uint8_t s = state.load(std::memory_order_acquire);
   if (s == 0 && state.compare_exchange_strong(s, 1, std::memory_order_acq_rel)) {
-    Rect rr = region_rect(region);
-    const Coord grow = static_cast<Coord>(kUnitsPerMm);
-    rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
     Paths& out = off.cut[i];
     out.clear();
-    if (off.box.x0 >= rr.x0 && off.box.x1 <= rr.x1 && off.box.y0 >= rr.y0 && off.box.y1 <= rr.y1) {
-      off.whole[i] = 1;  // wholly inside: nothing to cut
-    } else {
-      off.whole[i] = 0;
-      ClipperLib::Clipper& k = ws.rect_clipper;
-      k.Clear();
-      k.AddPaths(off.paths, ClipperLib::ptSubject, true);
-      k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
-      k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-    }
+    ClipperLib::Clipper& k = ws.rect_clipper;
+    k.Clear();
+    k.AddPaths(off.paths, ClipperLib::ptSubject, true);
+    k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
+    k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
     state.store(2, std::memory_order_release);
   } else {
-    while (state.load(std::memory_order_acquire) != 2) {
-#if defined(__x86_64__) || defined(__i386__)
-      __builtin_ia32_pause();
-#endif
-    }
+    while (state.load(std::memory_order_acquire) != 2) cpu_relax();
   }
-  return off.whole[i] != 0 ? off.paths : off.cut[i];
+  return off.cut[i];
 }
 
 // Clips one cell with the level's sections; true when the cell changed.

@@ -6,7 +6,7 @@
 // counters; runs of equal levels are clipped once). The calling thread is worker 0.
 // Used by the offline runner only; the live geometry thread subtracts on its own.
 //
-// A batch takes well under a millisecond once the kernel is fast (low: ~0.36 ms), so the
+// A batch takes well under a millisecond once the kernel is fast (low: ~0.33 ms on one thread), so the
 // hand-over must cost microseconds: workers and the caller spin on atomics for a short while
 // (kSpin) before they block on the condition variables, which are only signalled when
 // someone actually sleeps.

@@ -107,7 +107,6 @@ struct LevelSections {
   std::vector<std::uint32_t> chain_offset;  // per chain: its offset on this level, or ~0
   Rect all;                           // union of the boxes
   int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // regions that the boxes reach
-  bool same_as_below = false;         // equal to the level below's sections
   std::vector<std::uint8_t> same_cell_below;  // per region: same start as the level below
   std::vector<std::uint32_t> cost;            // per region: the cell's vertices before the batch
   [[nodiscard]] bool empty() const noexcept { return ix1 < ix0 || iy1 < iy0; }
@@ -156,7 +155,6 @@ struct SubtractShared {
     int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;
     std::vector<Paths> cut;            // (iy - iy0) * (ix1 - ix0 + 1) + (ix - ix0)
     std::vector<std::uint8_t> state;   // per piece: 0 not cut, 1 being cut, 2 cut (atomic_ref)
-    std::vector<std::uint8_t> whole;   // per piece: the offset lies inside it, uncut
   };
   std::vector<Offset> offsets;
   std::atomic<std::size_t> next[3] = {};  // work counters: phase A, phase C, next batch's offsets
