@@ -357,10 +357,10 @@ INSTANTIATE_TEST_SUITE_P(
     Messages, GcodeErrors,
     ::testing::Values(
         ErrorCase{"G0 X1\nG41 X1\n", "t.ngc:2: unsupported word 'G41' (cutter radius compensation; use --interpreter rs274)"},
-        ErrorCase{"G0 X1\n\no100 sub\n", "t.ngc:3: unsupported word 'O100' (O-word subroutines and control flow; use --interpreter rs274)"},
-        ErrorCase{"#1 = 5\n", "t.ngc:1: unsupported word '#1' (parameters; use --interpreter rs274)"},
-        ErrorCase{"G0 X#1\n", "t.ngc:1: unsupported word 'X#1' (parameters; use --interpreter rs274)"},
-        ErrorCase{"G0 X[1+2]\n", "t.ngc:1: unsupported word 'X[1+2]' (expressions; use --interpreter rs274)"},
+        ErrorCase{"G0 X1\n\no100 sub\n", "t.ngc:3: 'o100 sub' is never closed"},
+        ErrorCase{"#1 = [1 / 0]\n", "t.ngc:1: division by zero"},
+        ErrorCase{"G0 X#<nope>\n", "t.ngc:1: named parameter '#<NOPE>' is not defined"},
+        ErrorCase{"G0 X[1+2\n", "t.ngc:1: expected ']' to close the expression"},
         ErrorCase{"G92 X0\n", "t.ngc:1: unsupported word 'G92' (G92 offsets; use --interpreter rs274)"},
         ErrorCase{"M98 P100\n", "t.ngc:1: unsupported word 'M98' (not supported by the built-in interpreter; use --interpreter rs274)"},
         ErrorCase{"G1 X1 F100 E5\n", "t.ngc:1: unsupported word 'E5'"},
@@ -391,8 +391,8 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"G28 G0 X1\n", "t.ngc:1: 'G0' and 'G28' both use the axis words"}));
 
 TEST(GcodeErrors, OWordNamesTheWord) {
-  EXPECT_EQ(error_of("O100 sub\n"),
-            "t.ngc:1: unsupported word 'O100' (O-word subroutines and control flow; use --interpreter rs274)");
+  EXPECT_EQ(error_of("O100 sub\n"), "t.ngc:1: 'o100 sub' is never closed");
+  EXPECT_EQ(error_of("G0 X1\nO100\n"), "t.ngc:2: O-word 'O100' without a keyword (sub, call, if, while, do, repeat, ...)");
 }
 
 TEST(GcodeErrors, ArcChordLimitIsAnErrorNotAHang) {

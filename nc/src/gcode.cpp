@@ -15,6 +15,8 @@
 #include <sstream>
 #include <vector>
 
+#include "ngc_control.hpp"
+#include "ngc_expr.hpp"
 #include "path_builder.hpp"
 
 namespace lbr::nc {
@@ -70,111 +72,178 @@ struct Block {
 
 int idx(char c) { return c - 'A'; }
 
+// One named system parameter's value (any arithmetic state converted to double).
+struct SysParam {
+  const char* name;
+  double value;
+  template <typename T>
+  SysParam(const char* n, T v) : name(n), value(static_cast<double>(v)) {}
+};
+
 class Interpreter {
  public:
   Interpreter(const std::string& name, const GcodeOptions& o)
-      : name_(name), opt_(o), b_(name, o), offsets_(o.work_offsets), g28_(o.g28_home), g30_(o.g30_home) {
+      : name_(name), opt_(o), b_(name, o), expr_(params_),
+        flow_(params_, o, [this](const detail::NormalisedLine& l) { return execute_line(l); }),
+        offsets_(o.work_offsets), g28_(o.g28_home), g30_(o.g30_home) {
     selected_tool_ = o.start_tool;
+    params_.numbered_hook = [this](int n, double& v) { return system_numbered(n, v); };
+    params_.named_hook = [this](const std::string& n, double& v) { return system_named(n, v); };
   }
 
   Toolpath run(const std::string& text) {
-    std::istringstream in(text);
-    std::string raw;
-    int percent = 0;
-    while (std::getline(in, raw)) {
-      ++line_;
-      if (!raw.empty() && raw.back() == '\r') raw.pop_back();
-      const auto first = raw.find_first_not_of(" \t");
-      if (first != std::string::npos && raw[first] == '%') {
-        if (++percent == 2) break;  // closing delimiter: the program ends here
-        continue;
-      }
-      Block blk = parse(raw);
-      if (blk.empty()) continue;
-      execute(blk);
-      if (ended_) break;
-    }
+    flow_.run(text, name_);
     return b_.take();
   }
 
  private:
-  [[noreturn]] void fail(const std::string& msg) const { throw ParseError(name_, line_, msg); }
+  [[noreturn]] void fail(const std::string& msg) const { flow_.fail(msg); }
+
+  // One line that is not an O-word line: parameter settings take effect after the whole line
+  // has been read (RS274/NGC), then the block executes. Returns true at the program's end.
+  bool execute_line(const detail::NormalisedLine& l) {
+    line_ = flow_.main_line();
+    pending_.clear();
+    Block blk = parse(l.code);
+    for (const detail::ParamAssign& a : pending_) {
+      if (a.number > 0) params_.set_numbered(a.number, a.value);
+      else params_.set_named(a.name, a.value);
+    }
+    if (blk.empty()) return false;
+    execute(blk);
+    return ended_;
+  }
+
+  // ---- system parameters (read-only, computed when read; LinuxCNC's numbering and names) ----
+  double units(double mm) const { return mm / scale_; }
+  bool system_numbered(int n, double& v) const {
+    const AxisVector p = b_.position();
+    auto axis = [&](const AxisVector& a, int k) { return k < kAxes ? (k <= Z ? units(a[k]) : a[k]) : 0.0; };
+    if (n >= 5161 && n <= 5169) v = axis(g28_, n - 5161);
+    else if (n >= 5181 && n <= 5189) v = axis(g30_, n - 5181);
+    else if (n >= 5211 && n <= 5219) v = axis(g92_, n - 5211);
+    else if (n == 5210) v = g92_on_ ? 1.0 : 0.0;
+    else if (n == 5220) v = wcs_ + 1;
+    else if (n >= 5221 && n <= 5400 - 1 && (n - 5221) % 20 < 9) v = axis(offsets_[static_cast<std::size_t>((n - 5221) / 20)], (n - 5221) % 20);
+    else if (n == 5400) v = b_.tool();
+    else if (n == 5403) v = units(b_.tool_length_offset());
+    else if (n >= 5401 && n <= 5409) v = 0.0;
+    else if (n == 5410) v = units(tool_diameter(b_.tool()));
+    else if (n >= 5420 && n <= 5428) v = axis(p, n - 5420);
+    else return false;
+    return true;
+  }
+  double tool_diameter(int t) const {
+    const auto it = opt_.tool_diameters.find(t);
+    return it == opt_.tool_diameters.end() ? 0.0 : it->second;
+  }
+  bool system_named(const std::string& n, double& v) const {
+    if (n.empty() || n[0] != '_') return false;
+    const AxisVector p = b_.position();
+    static const char* const kAxisNames[] = {"_X", "_Y", "_Z", "_A", "_B", "_C"};
+    for (int a = 0; a < kAxes; ++a)
+      if (n == kAxisNames[a]) return v = a <= Z ? units(p[a]) : p[a], true;
+    if (n == "_U" || n == "_V" || n == "_W") return v = 0.0, true;
+    const SysParam table[] = {
+        {"_VMAJOR", 2.0}, {"_VMINOR", 9.0}, {"_LINE", flow_.line()}, {"_MOTION_MODE", motion_ < 0 ? 800 : motion_},
+        {"_PLANE", plane_ == Plane::XY ? 170 : plane_ == Plane::ZX ? 180 : 190}, {"_CCOMP", 400},
+        {"_METRIC", scale_ == 1.0}, {"_IMPERIAL", scale_ != 1.0}, {"_ABSOLUTE", absolute_}, {"_INCREMENTAL", !absolute_},
+        {"_INVERSE_TIME", inverse_time_}, {"_UNITS_PER_MINUTE", !inverse_time_}, {"_UNITS_PER_REV", 0.0},
+        {"_COORD_SYSTEM", wcs_ < 6 ? 540 + 10 * wcs_ : 591 + (wcs_ - 6)}, {"_TOOL_OFFSET", b_.tool_length_offset() != 0.0},
+        {"_RETRACT_R_PLANE", !retract_to_initial_}, {"_RETRACT_OLD_Z", retract_to_initial_},
+        {"_SPINDLE_RPM_MODE", 1.0}, {"_SPINDLE_CSS_MODE", 0.0}, {"_IJK_ABSOLUTE_MODE", arc_absolute_},
+        {"_LATHE_DIAMETER_MODE", diameter_mode_}, {"_LATHE_RADIUS_MODE", !diameter_mode_},
+        {"_SPINDLE_ON", spindle_ != 5}, {"_SPINDLE_CW", spindle_ == 3}, {"_MIST", coolant_ == 7}, {"_FLOOD", coolant_ == 8},
+        {"_SPEED_OVERRIDE", 1.0}, {"_FEED_OVERRIDE", 1.0}, {"_ADAPTIVE_FEED", 0.0}, {"_FEED_HOLD", 0.0},
+        {"_FEED", feed_}, {"_RPM", spindle_rpm_}, {"_CURRENT_TOOL", b_.tool()}, {"_CURRENT_POCKET", b_.tool()},
+        {"_SELECTED_TOOL", selected_tool_}, {"_SELECTED_POCKET", selected_tool_}, {"_CALL_LEVEL", flow_.call_level()},
+        {"_REMAP_LEVEL", 0.0}, {"_TASK", 0.0},
+    };
+    for (const auto& e : table)
+      if (n == e.name) return v = e.value, true;
+    return false;
+  }
 
   // ---- parsing -------------------------------------------------------------------------
-  Block parse(const std::string& s) {
-    Block blk;
-    std::size_t i = 0;
+  // A word's value: a number as written (the common case, kept as text for messages), or a
+  // parameter, expression or function (ngc_expr.hpp).
+  double word_value(const std::string& s, std::size_t& i, char L) {
     const std::size_t n = s.size();
-    auto skip_ws = [&] {
-      while (i < n && (s[i] == ' ' || s[i] == '\t')) ++i;
-    };
-    skip_ws();
-    if (i < n && s[i] == '/') ++i;  // block delete switch is off: the block runs
-    while (true) {
-      skip_ws();
-      if (i >= n) break;
-      const char c = s[i];
-      if (c == ';') break;
-      if (c == '(') {
-        const auto close = s.find(')', i);
-        if (close == std::string::npos) fail("unclosed comment '('");
-        i = close + 1;
-        continue;
-      }
-      if (c == '#') {
-        std::size_t e = i + 1;
-        while (e < n && s[e] != ' ' && s[e] != '\t' && s[e] != '=') ++e;
-        fail("unsupported word '" + s.substr(i, e - i) + "' (parameters" + kUseRs274 + ")");
-      }
-      if (c == '[') fail(std::string("unsupported word '[' (expressions") + kUseRs274 + ")");
-      if (!std::isalpha(static_cast<unsigned char>(c))) {
-        fail(std::string("unexpected character '") + c + "'");
-      }
-      const char L = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-      ++i;
-      skip_ws();
-      if (L == 'O') {
-        std::size_t e = i;
-        while (e < n && std::isalnum(static_cast<unsigned char>(s[e]))) ++e;
-        fail("unsupported word 'O" + s.substr(i, e - i) + "' (O-word subroutines and control flow" + kUseRs274 + ")");
-      }
-      if (i < n && (s[i] == '[' || s[i] == '#')) {
-        std::size_t e = i;
-        while (e < n && s[e] != ' ' && s[e] != '\t') ++e;
-        fail(std::string("unsupported word '") + L + s.substr(i, e - i) + "' (" +
-             (s[i] == '[' ? "expressions" : "parameters") + kUseRs274 + ")");
-      }
-      const std::size_t num_start = i;
-      if (i < n && (s[i] == '+' || s[i] == '-')) ++i;
+    const bool sign = i < n && (s[i] == '+' || s[i] == '-');
+    if (detail::ExprReader::number_starts(s, i + (sign ? 1 : 0))) {
+      if (sign) ++i;
       std::size_t digits = 0;
       while (i < n && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++digits;
       if (i < n && s[i] == '.') {
         ++i;
         while (i < n && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++digits;
       }
-      if (digits == 0) fail(std::string("word '") + L + "' has no number");
-      const std::string num = s.substr(num_start, i - num_start);
-      const double v = std::strtod(num.c_str(), nullptr);
-      Word w{L, v, std::string(1, L) + num};
-      if (!std::isfinite(v) || std::abs(v) > kMaxAbsValue) fail("number out of range in '" + w.text + "'");
-      switch (L) {
-        case 'G': blk.g.push_back(w); break;
-        case 'M': blk.m.push_back(w); break;
-        case 'N': break;  // line number: no meaning to the motion
-        case 'X': case 'Y': case 'Z': case 'A': case 'B': case 'C': case 'I': case 'J': case 'K':
-        case 'R': case 'P': case 'Q': case 'L': case 'H': case 'F': case 'S': case 'T': case 'D': {
-          const int k = idx(L);
-          if (blk.has[k]) fail("word '" + std::string(1, L) + "' given twice ('" + blk.text[k] + "', '" + w.text + "')");
-          blk.has[k] = true;
-          blk.val[k] = v;
-          blk.text[k] = w.text;
-          break;
-        }
-        case 'U': case 'V': case 'W': fail("unsupported word '" + w.text + "' (axes U, V, W are not supported)");
-        default: fail("unsupported word '" + w.text + "'");
+      return 0.0;  // the caller converts the text
+    }
+    const bool expr = i < n && (s[i] == '[' || s[i] == '#' || s[i] == '+' || s[i] == '-' || is_function_at(s, i));
+    if (!expr) fail(std::string("word '") + L + "' has no number");
+    return expr_.value(s, i);
+  }
+  static bool is_function_at(const std::string& s, std::size_t i) {
+    static const char* const kFunctions[] = {"ABS[", "ACOS[", "ASIN[", "ATAN[", "COS[", "EXP[", "FIX[", "FUP[",
+                                             "ROUND[", "LN[", "SIN[", "SQRT[", "TAN[", "EXISTS["};
+    for (const char* f : kFunctions)
+      if (s.compare(i, std::string(f).size(), f) == 0) return true;
+    return false;
+  }
+  static std::string printable(char c) {
+    if (std::isprint(static_cast<unsigned char>(c))) return std::string(1, c);
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "\\x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+    return buf;
+  }
+
+  Block parse(const std::string& s) {
+    Block blk;
+    std::size_t i = 0;
+    const std::size_t n = s.size();
+    if (i < n && s[i] == '/') ++i;  // block delete switch is off: the block runs
+    while (i < n) {
+      const char c = s[i];
+      if (c == '#') {
+        pending_.push_back(expr_.assignment(s, i));
+        continue;
       }
+      if (!std::isalpha(static_cast<unsigned char>(c))) fail("unexpected character '" + printable(c) + "'");
+      const char L = c;
+      ++i;
+      if (L == 'O') fail("O-word '" + s.substr(i - 1) + "' must begin the line");
+      const std::size_t num_start = i;
+      double v = word_value(s, i, L);
+      const std::string written = s.substr(num_start, i - num_start);
+      if (detail::ExprReader::number_starts(written, written[0] == '+' || written[0] == '-' ? 1 : 0) &&
+          written.find_first_of("[#") == std::string::npos && !is_function_at(written, 0))
+        v = std::strtod(written.c_str(), nullptr);
+      Word w{L, v, std::string(1, L) + written};
+      if (!std::isfinite(v) || std::abs(v) > kMaxAbsValue) fail("number out of range in '" + w.text + "'");
+      add_word(blk, w);
     }
     return blk;
+  }
+
+  void add_word(Block& blk, const Word& w) {
+    const char L = w.letter;
+    switch (L) {
+      case 'G': blk.g.push_back(w); break;
+      case 'M': blk.m.push_back(w); break;
+      case 'N': break;  // line number: no meaning to the motion
+      case 'X': case 'Y': case 'Z': case 'A': case 'B': case 'C': case 'I': case 'J': case 'K':
+      case 'R': case 'P': case 'Q': case 'L': case 'H': case 'F': case 'S': case 'T': case 'D': {
+        const int k = idx(L);
+        if (blk.has[k]) fail("word '" + std::string(1, L) + "' given twice ('" + blk.text[k] + "', '" + w.text + "')");
+        blk.has[k] = true;
+        blk.val[k] = w.value;
+        blk.text[k] = w.text;
+        break;
+      }
+      case 'U': case 'V': case 'W': fail("unsupported word '" + w.text + "' (axes U, V, W are not supported)");
+      default: fail("unsupported word '" + w.text + "'");
+    }
   }
 
   // ---- word access -----------------------------------------------------------------------
@@ -384,7 +453,16 @@ class Interpreter {
       else k = 6 + (c - 591);
       select_wcs(k);
     }
-    // kPath: G61/G61.1/G64 are accepted; the emulator always stops exactly at corners.
+    // kPath: G61/G61.1/G64 [P tolerance] [Q naive-cam tolerance] are recorded; the emulator
+    // stops exactly at corners (docs/nc-frontend.md#motion-model).
+    if (gw[kPath]) {
+      path_mode_ = code10(*gw[kPath]);
+      if (path_mode_ == 640) {
+        if (has(b, 'P')) path_tol_mm_ = len(b, 'P');
+        if (has(b, 'Q')) path_q_tol_mm_ = len(b, 'Q');
+        if (path_tol_mm_ < 0.0 || path_q_tol_mm_ < 0.0) fail("'G64' tolerances P and Q must be >= 0");
+      }
+    }
     if (gw[kDistance]) absolute_ = code10(*gw[kDistance]) == 900;
     if (gw[kArcDistance]) arc_absolute_ = code10(*gw[kArcDistance]) == 901;
     if (gw[kRetract]) retract_to_initial_ = code10(*gw[kRetract]) == 980;
@@ -711,8 +789,14 @@ class Interpreter {
   std::string name_;
   const GcodeOptions& opt_;
   PathBuilder b_;
+  detail::Params params_;
+  detail::ExprReader expr_;
+  detail::ControlFlow flow_;
+  std::vector<detail::ParamAssign> pending_;
   std::array<AxisVector, 9> offsets_;
   AxisVector g28_, g30_;
+  AxisVector g92_{};      // G92 offset [mm, deg]
+  bool g92_on_ = false;
   int line_ = 0;
   bool ended_ = false;
   int wcs_ = 0;
@@ -720,6 +804,8 @@ class Interpreter {
   bool absolute_ = true, arc_absolute_ = false, inverse_time_ = false, retract_to_initial_ = true;
   bool diameter_mode_ = opt_.diameter_mode;
   bool polar_ = false;  // G12.1 in effect (lathe-c)
+  int path_mode_ = 640;                                 // G61 (610), G61.1 (611), G64 (640)
+  double path_tol_mm_ = 0.0, path_q_tol_mm_ = 0.0;    // G64 P, Q [mm]
   Plane plane_ = Plane::XY;
   int motion_ = -1;  // code x 10; -1: none (G80 or program start)
   double feed_ = 0.0;

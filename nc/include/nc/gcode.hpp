@@ -17,6 +17,7 @@
 #include <array>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "nc/toolpath.hpp"
 
@@ -45,6 +46,11 @@ struct GcodeOptions {
   AxisVector start_machine{};  // gauge line at program start, machine coordinates (homed: 0)
   int start_tool = 0;          // tool in the spindle at program start (0 = none)
   bool diameter_mode = false;  // lathe kinds: G7 (X words are diameters) at program start
+  // Directories searched for NAME.ngc when a program calls o<name> that it does not define,
+  // after the program's own directory (profile [nc] subroutine_path; LinuxCNC's SUBROUTINE_PATH).
+  std::vector<std::string> subroutine_path;
+  // At most this many blocks are executed (loops included); more is an error, not a hang. 0: no limit.
+  long max_blocks = 20000000;
 };
 
 // Interprets G-code text. `name` is used in messages and as Toolpath::source. Arcs become
