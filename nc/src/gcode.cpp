@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <vector>
 
@@ -265,7 +266,7 @@ class Interpreter {
   bool axis_allowed(int a) const {
     switch (opt_.machine) {
       case MachineKind::Mill3: return a <= Z;
-      case MachineKind::MillRotary: return true;
+      case MachineKind::MillRotary: return a <= Z || opt_.rotary[static_cast<std::size_t>(a - A)];
       case MachineKind::Lathe: return a == X || a == Z;
       case MachineKind::LatheC: return a == X || a == Y || a == Z || a == C;
     }
@@ -274,11 +275,18 @@ class Interpreter {
   const char* machine_name() const {
     switch (opt_.machine) {
       case MachineKind::Mill3: return "mill3 has X Y Z";
-      case MachineKind::MillRotary: return "mill-rotary has X Y Z A B C";
+      case MachineKind::MillRotary: return rotary_name();
       case MachineKind::Lathe: return "lathe has X Z";
       case MachineKind::LatheC: return "lathe-c has X Y Z C";
     }
     return "?";
+  }
+  const char* rotary_name() const {
+    static const char* const kNames[8] = {"mill-rotary has X Y Z",       "mill-rotary has X Y Z A",
+                                          "mill-rotary has X Y Z B",     "mill-rotary has X Y Z A B",
+                                          "mill-rotary has X Y Z C",     "mill-rotary has X Y Z A C",
+                                          "mill-rotary has X Y Z B C",   "mill-rotary has X Y Z A B C"};
+    return kNames[(opt_.rotary[0] ? 1 : 0) + (opt_.rotary[1] ? 2 : 0) + (opt_.rotary[2] ? 4 : 0)];
   }
   bool any_axis(const Block& b) const {
     for (char L : kAxisLetters)
@@ -314,7 +322,7 @@ class Interpreter {
   static int code10(const Word& w) { return static_cast<int>(std::lround(w.value * 10.0)); }
 
   enum Group { kMotion, kPlane, kDistance, kArcDistance, kFeedMode, kUnits, kCutter, kLength, kRetract, kCoord,
-               kPath, kLathe, kPolar, kNonModal, kGroups };
+               kPath, kLathe, kPolar, kSpindleMode, kNonModal, kGroups };
   int group_of(const Word& w) const {
     const int c = code10(w);
     if (std::abs(w.value * 10.0 - c) > 1e-6) return -1;
@@ -323,7 +331,8 @@ class Interpreter {
       case 170: case 180: case 190: return kPlane;
       case 900: case 910: return kDistance;
       case 901: case 911: return kArcDistance;
-      case 930: case 940: return kFeedMode;
+      case 930: case 940: case 950: return kFeedMode;
+      case 960: case 970: return kSpindleMode;
       case 200: case 210: return kUnits;
       case 400: return kCutter;
       case 430: case 490: return kLength;
@@ -332,7 +341,8 @@ class Interpreter {
       case 610: case 611: case 640: return kPath;
       case 70: case 80: return kLathe;
       case 121: case 131: return kPolar;
-      case 40: case 100: case 280: case 281: case 300: case 301: case 530: return kNonModal;
+      case 40: case 100: case 280: case 281: case 300: case 301: case 530: case 920: case 921: case 922: case 923:
+        return kNonModal;
       default: return -1;
     }
   }
@@ -340,10 +350,11 @@ class Interpreter {
     const int c = code10(w);
     const char* why = "not supported by the built-in interpreter";
     if (c == 410 || c == 420 || c == 411 || c == 421) why = "cutter radius compensation";
-    else if (c == 920 || c == 921 || c == 922 || c == 923) why = "G92 offsets";
+    if (c == 330 || c == 331 || c == 760)
+      return "unsupported word '" + w.text + "' (spindle-synchronised motion: the tool path carries no spindle angle)";
     else if (c == 381 || c == 382 || c == 383 || c == 384) why = "probing";
     else if (c == 431) why = "dynamic tool length offset";
-    else if (c == 330 || c == 331 || c == 760 || c == 840 || c == 850 || c == 860 || c == 870 || c == 880 ||
+    else if (c == 840 || c == 850 || c == 860 || c == 870 || c == 880 ||
              c == 890)
       why = "this cycle";
     return "unsupported word '" + w.text + "' (" + why + kUseRs274 + ")";
@@ -363,11 +374,12 @@ class Interpreter {
       if (gw[gr] != nullptr) fail("'" + gw[gr]->text + "' and '" + w.text + "' are in the same modal group");
       gw[gr] = &w;
     }
-    int dwell = 0, g10 = 0, home = 0, g53 = 0;  // home: 280, 281, 300, 301
+    int dwell = 0, g10 = 0, home = 0, g53 = 0, g92 = 0;  // home: 280, 281, 300, 301
     for (const Word* w : nonmodal) {
       const int c = code10(*w);
-      int* slot = c == 40 ? &dwell : c == 100 ? &g10 : c == 530 ? &g53 : &home;
-      if (*slot != 0 || (slot == &g10 && home != 0) || (slot == &home && g10 != 0))
+      int* slot = c == 40 ? &dwell : c == 100 ? &g10 : c == 530 ? &g53 : c >= 920 ? &g92 : &home;
+      if (*slot != 0 || (slot == &g10 && (home != 0 || g92 != 0)) || (slot == &home && (g10 != 0 || g92 != 0)) ||
+          (slot == &g92 && (g10 != 0 || home != 0)))
         fail("'" + w->text + "' cannot be combined with another non-modal G-code in the block");
       *slot = c;
     }
@@ -375,6 +387,8 @@ class Interpreter {
     const Word* mspindle = nullptr;
     const Word* m6 = nullptr;
     const Word* mcool = nullptr;
+    const Word* m61 = nullptr;
+    const Word* mio = nullptr;  // overrides, digital outputs: nothing to simulate
     for (const Word& w : b.m) {
       const int c = static_cast<int>(std::lround(w.value));
       if (w.value != std::floor(w.value)) fail("unsupported word '" + w.text + "'");
@@ -384,8 +398,14 @@ class Interpreter {
         case 3: case 4: case 5: slot = &mspindle; break;
         case 6: slot = &m6; break;
         case 7: case 8: case 9: slot = &mcool; break;
-        default: fail("unsupported word '" + w.text + "' (not supported by the built-in interpreter" +
-                      std::string(kUseRs274) + ")");
+        case 61: slot = &m61; break;
+        case 48: case 49: case 50: case 51: case 52: case 53: case 62: case 63: case 64: case 65: slot = &mio; break;
+        default:
+          if (c >= 100 && c <= 199)
+            fail("unsupported word '" + w.text + "' (user-defined M-code: runs a program on the controller)");
+          if (c >= 200) fail("unsupported word '" + w.text + "' (machine-specific M-code or remap)");
+          fail("unsupported word '" + w.text + "' (not supported by the built-in interpreter" + std::string(kUseRs274) +
+               ")");
       }
       if (*slot != nullptr && !(c == 7 || c == 8))
         fail("'" + (*slot)->text + "' and '" + w.text + "' are in the same modal group");
@@ -393,21 +413,38 @@ class Interpreter {
     }
 
     // 1. feed mode, F
-    if (gw[kFeedMode]) inverse_time_ = code10(*gw[kFeedMode]) == 930;
+    if (gw[kFeedMode]) {
+      inverse_time_ = code10(*gw[kFeedMode]) == 930;
+      per_rev_ = code10(*gw[kFeedMode]) == 950;
+    }
     bool f_in_block = false;
     if (has(b, 'F')) {
       feed_ = raw(b, 'F');
       if (feed_ < 0) fail("'" + text(b, 'F') + "': feed rate must be >= 0");
       f_in_block = true;
     }
-    // 2. S
+    // 2. S, with the spindle speed mode: G97 S [rpm], G96 S [m/min | ft/min] D [max rpm]
     if (has(b, 'S')) {
       spindle_rpm_ = raw(b, 'S');
       if (spindle_rpm_ < 0) fail("'" + text(b, 'S') + "': spindle speed must be >= 0");
     }
+    if (gw[kSpindleMode]) {
+      css_ = code10(*gw[kSpindleMode]) == 960;
+      if (css_ && has(b, 'D')) css_max_rpm_ = raw(b, 'D');
+    }
     // 3. T (select), 4. M6 (change)
     if (has(b, 'T')) selected_tool_ = integer(b, 'T', 0, 99999);
     if (m6 != nullptr) b_.tool_change(line_, selected_tool_);
+    if (m61 != nullptr) {
+      if (!has(b, 'Q')) fail("'M61' needs Q (the tool in the spindle)");
+      selected_tool_ = integer(b, 'Q', 0, 99999);
+      b_.tool_change(line_, selected_tool_);
+    }
+    if (mio != nullptr) {
+      const int c = static_cast<int>(mio->value);
+      if (c >= 62 && !has(b, 'P')) fail("'" + mio->text + "' needs P (output number)");
+      if (has(b, 'P')) (void)raw(b, 'P');
+    }
     // 5. spindle, coolant
     if (mspindle != nullptr) spindle_ = static_cast<int>(mspindle->value);
     if (mcool != nullptr) coolant_ = static_cast<int>(mcool->value);
@@ -482,6 +519,10 @@ class Interpreter {
     }
     if (g10 != 0) {
       do_g10(b);
+    } else if (g92 != 0) {
+      if (gw[kMotion] != nullptr && any_axis(b))
+        fail("'" + gw[kMotion]->text + "' and 'G92' both use the axis words");
+      do_g92(b, g92);
     } else if (home != 0) {
       if (gw[kMotion] != nullptr && any_axis(b))
         fail("'" + gw[kMotion]->text + "' and 'G" + (home < 300 ? std::string("28") : std::string("30")) +
@@ -508,7 +549,8 @@ class Interpreter {
 
     // Every word must have been used by something in the block.
     for (char L : {'X', 'Y', 'Z', 'A', 'B', 'C', 'F', 'S', 'T'}) b.used[idx(L)] = b.used[idx(L)] || has(b, L);
-    if (has(b, 'D')) fail("unsupported word '" + text(b, 'D') + "' (cutter radius compensation" + kUseRs274 + ")");
+    if (has(b, 'D') && !b.used[idx('D')])
+      fail("unsupported word '" + text(b, 'D') + "' (cutter radius compensation" + kUseRs274 + ")");
     for (int k = 0; k < 26; ++k)
       if (b.has[k] && !b.used[k]) fail("unused word '" + b.text[k] + "' (no G-code in the block uses it)");
 
@@ -522,24 +564,59 @@ class Interpreter {
 
   static bool is_cycle(int c) { return c == 810 || c == 820 || c == 830 || c == 730; }
 
+  // The program frame: the selected work offset plus the G92 offset while it is applied.
   void select_wcs(int k) {
     const AxisVector m = b_.to_machine(b_.position());
     wcs_ = k;
-    b_.set_origin(offsets_[static_cast<std::size_t>(k)]);
+    AxisVector o = offsets_[static_cast<std::size_t>(k)];
+    if (g92_on_)
+      for (int a = 0; a < kAxes; ++a) o[a] += g92_[a];
+    b_.set_origin(o);
     b_.set_position(b_.from_machine(m));
   }
 
+  // G92 (the current point gets the given coordinates), G92.1 (cancel, zero), G92.2 (cancel,
+  // keep), G92.3 (apply the kept offset), as LinuxCNC.
+  void do_g92(Block& b, int code) {
+    if (code == 920) {
+      if (!any_axis(b)) fail("'G92' needs at least one axis word");
+      const AxisVector p = b_.position();
+      const AxisVector old = g92_on_ ? g92_ : AxisVector{};
+      for (int a = 0; a < kAxes; ++a)
+        if (has(b, kAxisLetters[a])) g92_[a] = p[a] + old[a] - axis_value(b, a);
+        else if (!g92_on_) g92_[a] = 0.0;
+      g92_on_ = true;
+    } else if (code == 921) {
+      g92_ = {};
+      g92_on_ = false;
+    } else if (code == 922) {
+      g92_on_ = false;
+    } else {
+      g92_on_ = true;
+    }
+    select_wcs(wcs_);
+  }
+
+  // G10 L2 (work offset = the values) and G10 L20 (work offset such that the current point
+  // has the values).
   void do_g10(Block& b) {
-    if (!has(b, 'L') || raw(b, 'L') != 2.0)
-      fail("'G10' needs L2 (work offsets); " + (has(b, 'L') ? "'" + text(b, 'L') + "'" : std::string("no L word")) +
+    const double l = has(b, 'L') ? raw(b, 'L') : -1.0;
+    if (l != 2.0 && l != 20.0)
+      fail("'G10' needs L2 or L20 (work offsets); " + (has(b, 'L') ? "'" + text(b, 'L') + "'" : std::string("no L word")) +
            " is not supported");
-    if (has(b, 'R')) fail("unsupported word '" + text(b, 'R') + "' (G10 L2 rotation)");
-    if (!has(b, 'P')) fail("'G10 L2' needs P0..P9 (coordinate system)");
+    const std::string g = l == 2.0 ? "'G10 L2'" : "'G10 L20'";
+    if (has(b, 'R')) fail("unsupported word '" + text(b, 'R') + "' (" + g + " rotation)");
+    if (!has(b, 'P')) fail(g + " needs P0..P9 (coordinate system)");
     int p = integer(b, 'P', 0, 9);
     const int k = p == 0 ? wcs_ : p - 1;
     AxisVector& o = offsets_[static_cast<std::size_t>(k)];
-    for (int a = 0; a < kAxes; ++a)
-      if (has(b, kAxisLetters[a])) o[a] = axis_value(b, a);
+    const AxisVector m = b_.to_machine(b_.position());
+    for (int a = 0; a < kAxes; ++a) {
+      if (!has(b, kAxisLetters[a])) continue;
+      const double v = axis_value(b, a);
+      if (l == 2.0) o[a] = v;
+      else o[a] = m[a] - (a == Z ? b_.tool_length_offset() : 0.0) - (g92_on_ ? g92_[a] : 0.0) - v;
+    }
     if (k == wcs_) select_wcs(k);
   }
 
@@ -564,7 +641,24 @@ class Interpreter {
       return feed_;
     }
     if (feed_ <= 0.0) fail("'" + g + "' needs a feed rate: no F word > 0 given yet");
+    if (per_rev_) {
+      const double rpm = spindle_rpm_now();
+      if (!(rpm > 0.0)) fail("'" + g + "' in feed per revolution (G95) needs a spindle speed S > 0");
+      return feed_ * scale_ * rpm;
+    }
     return feed_ * scale_;
+  }
+
+  // Spindle speed at the current point [rpm]: S in G97; in G96 the speed that gives the
+  // surface speed S at the current radius |X| (capped by G96 D), as LinuxCNC computes it.
+  double spindle_rpm_now() const {
+    if (!css_) return spindle_rpm_;
+    const double surface_mm_per_min = spindle_rpm_ * (scale_ == 1.0 ? 1000.0 : 304.8);
+    const double r = std::abs(b_.position()[X]);
+    double rpm = r > 1e-6 ? surface_mm_per_min / (2.0 * std::numbers::pi * r) : 1e300;
+    if (css_max_rpm_ > 0.0) rpm = std::min(rpm, css_max_rpm_);
+    if (rpm > 1e9) fail("'G96' at the spindle axis needs a maximum speed (G96 D)");
+    return rpm;
   }
 
   void move_line(int c, const AxisVector& t, bool f_in_block) {
@@ -802,6 +896,9 @@ class Interpreter {
   int wcs_ = 0;
   double scale_ = 1.0;  // mm per program length unit
   bool absolute_ = true, arc_absolute_ = false, inverse_time_ = false, retract_to_initial_ = true;
+  bool per_rev_ = false;        // G95: F is [length unit / revolution]
+  bool css_ = false;            // G96 constant surface speed (else G97 rpm)
+  double css_max_rpm_ = 0.0;    // G96 D [rpm]; 0: none
   bool diameter_mode_ = opt_.diameter_mode;
   bool polar_ = false;  // G12.1 in effect (lathe-c)
   int path_mode_ = 640;                                 // G61 (610), G61.1 (611), G64 (640)

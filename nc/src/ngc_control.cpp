@@ -361,8 +361,8 @@ void ControlFlow::call(const OWord& o) {
 
 void ControlFlow::leave(const OWord& o) {
   if (stack_.size() <= 1) fail(owtext(o) + " outside a subroutine");
-  if (stack_.back().label != o.label)
-    fail(owtext(o) + " inside subroutine o" + stack_.back().label);
+  // LinuxCNC lets 'return' carry any label (retval.ngc: o1010 return inside o1000); endsub
+  // labels are matched when the file is read.
   const std::string& code = stack_.back().file->lines[stack_.back().pc].code;
   std::size_t p = o.rest;
   double value = 0.0;

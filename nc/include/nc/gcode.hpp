@@ -26,7 +26,7 @@ namespace lbr::nc {
 // Which axis words a program may use.
 enum class MachineKind : unsigned char {
   Mill3,       // X Y Z
-  MillRotary,  // X Y Z A B C (rotary axes [deg] carried into Segment::end[A..C])
+  MillRotary,  // X Y Z and the rotary axes of GcodeOptions::rotary ([deg], carried into Segment::end[A..C])
   Lathe,       // X Z; G7 diameter mode / G8 radius mode apply to X words
   LatheC,      // X Y Z C (C spindle positioning [deg], live tools); G7 / G8 as Lathe
 };
@@ -49,6 +49,8 @@ struct GcodeOptions {
   // Directories searched for NAME.ngc when a program calls o<name> that it does not define,
   // after the program's own directory (profile [nc] subroutine_path; LinuxCNC's SUBROUTINE_PATH).
   std::vector<std::string> subroutine_path;
+  // MillRotary: which of A, B, C the machine has (a word for a missing one is an error).
+  std::array<bool, 3> rotary{true, true, true};
   // At most this many blocks are executed (loops included); more is an error, not a hang. 0: no limit.
   long max_blocks = 20000000;
 };
