@@ -502,6 +502,8 @@ const char* default_profile_text() noexcept { return kDefaultProfileToml; }
 
 Profile default_profile() { return parse_profile(kDefaultProfileToml, "<built-in default-mill3>"); }
 
+motion::ToolsConfig tool_config(const Profile& p) { return {p.tools, p.inserts, p.live_mounts}; }
+
 kin::Mount Profile::mount_of(int tool) const {
   if (inserts.count(tool)) return kin::Mount::Turning;
   const auto it = live_mounts.find(tool);

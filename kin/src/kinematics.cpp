@@ -150,9 +150,9 @@ int substeps(const Kinematics& k, const nc::AxisVector& q0, const nc::AxisVector
   // A point at distance ρ from the rotation axis turned by θ lies within ρ(1 − cos(θ/2)) of
   // the chord.
   const double step = 2.0 * std::acos(std::max(-1.0, 1.0 - std::min(1.0, tol_mm / radius)));
-  if (!(step > 0.0)) return kMaxSubsteps;
+  if (!(step > 0.0)) return kMaxMoveSubsteps;
   const double n = std::ceil(angle_deg * kDeg / step);
-  return static_cast<int>(std::clamp(n, 1.0, static_cast<double>(kMaxSubsteps)));
+  return static_cast<int>(std::clamp(n, 1.0, static_cast<double>(kMaxMoveSubsteps)));
 }
 
 }  // namespace lbr::kin

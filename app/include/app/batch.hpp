@@ -8,6 +8,8 @@
 
 #include "app/profile.hpp"
 #include "geom/lbr_solid.hpp"
+#include "motion/path_sweeps.hpp"
+#include "motion/tool_table.hpp"
 #include "nc/toolpath.hpp"
 
 namespace lbr::app {
@@ -32,12 +34,8 @@ using Progress = std::function<void(double)>;
 // spindle) remove nothing.
 [[nodiscard]] BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress = {});
 
-// One channel of a multi-channel run: its tool path and kinematics.
-struct ChannelPath {
-  std::string name;
-  nc::Toolpath path;
-  kin::Kinematics kin;
-};
+// One channel of a multi-channel run: its name, tool path and kinematics.
+using ChannelPath = motion::ChannelPath;
 
 // Runs several channels cutting the same stock (docs/machine-kinds.md#several-channels).
 // Every channel is timed by the machine emulator (emulator_limits(profile)); each segment's
@@ -48,6 +46,9 @@ struct ChannelPath {
 // machining_time_s is the longest channel's emulated time.
 [[nodiscard]] BatchResult run_batch_channels(const Profile& profile, const std::vector<ChannelPath>& channels,
                                              bool sampled = false, const Progress& progress = {});
+
+// The stock of `profile` with regions = auto sized for the tool with the most motions.
+[[nodiscard]] geom::SolidSpec batch_solid_spec(const Profile& profile, const motion::ToolTable& tools);
 
 // Machining time [s] of a tool path under the simple motion model of the batch runner
 // (feed and rapid rates, no acceleration).

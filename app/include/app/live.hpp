@@ -1,19 +1,21 @@
-// app/live.hpp — `lbrsim run`: the live pipeline.
+// app/live.hpp — `lbrsim run`: the live pipeline (implementation in app/src/live/).
 //
 //   HAL thread (RT, highest)  source.poll → validate → SpscRing<AxisSample>.try_push
 //                             (emulator:PROGRAM = nc::Emulator at live.period_ms, with tool numbers)
-//   geometry thread (RT)      drain the ring as soon as it holds samples, merge straight runs
-//                             of samples per channel into sweeps, LbrSolid::subtract(batch),
-//                             record lag = done − receive time of every applied sample
+//   geometry thread (RT)      drain the ring as soon as it holds samples, turn them into
+//                             sweeps (motion::SampleStream: kinematics, merged straight runs
+//                             per channel), LbrSolid::subtract(batch), record lag = done −
+//                             receive time of every applied sample
 //   recorder thread (non-RT)  --record: raw input → candump -l lines
 //   caller's thread           status line once a second; metrics.json at the end
-// The run ends when the source ends (replay, emulator, serial hang-up) or `stop` is set.
+// The run ends when the source ends (replay, emulator, serial hang-up) or a stop is asked for.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "app/profile.hpp"
@@ -59,7 +61,41 @@ struct LiveResult {
 
 using StatusFn = std::function<void(const std::string& line)>;
 
-// Setup errors (bad source spec, device cannot be opened, unknown tool) throw
+// The pipeline's lifecycle (as ros2_control's hardware components):
+//   configure()  setup: tool shapes, stock, source opened, rings, record file; calls
+//                opt.on_start with the initial solid. Throws std::runtime_error.
+//   start()      starts the geometry, HAL and (with --record) recorder threads.
+//   running()    true until the geometry thread has applied the last sample.
+//   stop()       asks the source loop to end (a no-op once the source has ended), joins the
+//                threads, closes the source. Idempotent.
+//   result()     after stop() (called if needed): the final solid and counters; once.
+// Every call is made from one control thread. `stop` (e.g. set by a signal handler) ends the
+// source loop like stop() does.
+class LivePipeline {
+ public:
+  LivePipeline(const Profile& profile, LiveOptions opt, const std::atomic<bool>& stop);
+  ~LivePipeline();
+  LivePipeline(const LivePipeline&) = delete;
+  LivePipeline& operator=(const LivePipeline&) = delete;
+
+  void configure();
+  void start();
+  [[nodiscard]] bool running() const noexcept;
+  // One status line with the counters so far (the caller's thread, once a second).
+  [[nodiscard]] std::string status_line();
+  // Asks the source loop to end without waiting (any thread).
+  void request_stop() noexcept;
+  void stop();
+  [[nodiscard]] LiveResult result();
+
+  struct Impl;  // app/src/live/pipeline.cpp
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// configure(), start(), a status line every opt.status_period_s until the run ends, stop(),
+// result(). Setup errors (bad source spec, device cannot be opened, unknown tool) throw
 // std::runtime_error; everything after start-up is counted instead.
 [[nodiscard]] LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::atomic<bool>& stop,
                                   const StatusFn& status = {});

@@ -11,6 +11,7 @@
 #include "geom/tool.hpp"
 #include "geom/turning.hpp"
 #include "kin/kinematics.hpp"
+#include "motion/tool_table.hpp"
 #include "hal/config.hpp"
 #include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
@@ -59,6 +60,9 @@ struct Profile {
   // Mount of tool n on this machine (Spindle on mills).
   [[nodiscard]] kin::Mount mount_of(int tool) const;
 };
+
+// The tool table's definitions (motion::ToolTable) from a profile.
+[[nodiscard]] motion::ToolsConfig tool_config(const Profile& p);
 
 // Parses profile text; `name` is used in messages. Throws ProfileError("name:line: ...").
 [[nodiscard]] Profile parse_profile(const std::string& text, const std::string& name);

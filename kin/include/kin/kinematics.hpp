@@ -72,8 +72,8 @@ struct Kinematics {
 
 // Pieces a move q0 → q1 needs so that every tool point within `reach_mm` of the tip stays
 // within `tol_mm` of the chords between consecutive poses (1 when no rotary axis that moves
-// the tip changes). At most kMaxSubsteps.
-inline constexpr int kMaxSubsteps = 4096;
+// the tip changes). At most kMaxMoveSubsteps.
+inline constexpr int kMaxMoveSubsteps = 4096;
 [[nodiscard]] int substeps(const Kinematics& k, const nc::AxisVector& q0, const nc::AxisVector& q1, Mount mount,
                            double tool_length_mm, double reach_mm, double tol_mm) noexcept;
 

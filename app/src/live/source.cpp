@@ -1,0 +1,53 @@
+#include "live/source.hpp"
+
+#include <stdexcept>
+
+#include "app/live.hpp"
+#include "app/outputs.hpp"
+#include "nc/emulator.hpp"
+
+namespace lbr::app::live {
+
+namespace {
+
+// The nc machine emulator at the live sample period, with the tool of every sample.
+class EmulatorGenerator final : public hal::SampleGenerator {
+ public:
+  EmulatorGenerator(const nc::Toolpath& path, const nc::EmulatorLimits& limits) : emu_(path, limits) {}
+  bool next(std::array<double, hal::kMaxAxes>& q, int& tool) noexcept override {
+    nc::Sample s;
+    if (!emu_.next(s)) return false;
+    for (std::size_t a = 0; a < q.size(); ++a) q[a] = s.axes[a];
+    tool = s.tool;
+    return true;
+  }
+
+ private:
+  nc::Emulator emu_;
+};
+
+std::unique_ptr<hal::Source> make_emulator_source(const Profile& profile, const std::string& arg, double speed) {
+  const nc::Toolpath path = arg == "demo" ? demo_toolpath() : load_toolpath(arg, profile);
+  for (const nc::Segment& sg : path.segments)
+    if (sg.tool != 0 && !profile.tools.count(sg.tool) && !profile.inserts.count(sg.tool))
+      throw std::runtime_error(path.source + ":" + std::to_string(sg.line) + ": tool " + std::to_string(sg.tool) +
+                               " is not in the tool table of " + profile.source);
+  return hal::make_generator_source(std::make_unique<EmulatorGenerator>(path, live_emulator_limits(profile)), arg,
+                                    profile.live, speed);
+}
+
+}  // namespace
+
+std::unique_ptr<hal::Source> make_source(const Profile& profile, const std::string& spec, double speed) {
+  const auto colon = spec.find(':');
+  if (colon == std::string::npos || colon + 1 >= spec.size())
+    throw std::runtime_error("--source '" + spec + "': expected can:IF, serial:DEV, replay:FILE or emulator:PROGRAM");
+  const std::string kind = spec.substr(0, colon), arg = spec.substr(colon + 1);
+  if (kind == "can") return hal::make_socketcan_source(arg, profile.live);
+  if (kind == "serial") return hal::make_serial_source(arg, profile.live);
+  if (kind == "replay") return hal::make_replay_source(arg, profile.live, speed);
+  if (kind == "emulator") return make_emulator_source(profile, arg, speed);
+  throw std::runtime_error("--source '" + spec + "': unknown kind '" + kind + "' (can, serial, replay, emulator)");
+}
+
+}  // namespace lbr::app::live

@@ -1,0 +1,130 @@
+#include "motion/sample_stream.hpp"
+
+#include <algorithm>
+
+namespace lbr::motion {
+
+namespace {
+
+// Distance of p from the segment a–b [mm].
+double dist_to_segment(geom::Vec3 p, geom::Vec3 a, geom::Vec3 b) noexcept {
+  const geom::Vec3 d = b - a;
+  const double dd = geom::dot(d, d);
+  const double t = dd > 0 ? std::clamp(geom::dot(p - a, d) / dd, 0.0, 1.0) : 0.0;
+  return geom::norm(p - geom::lerp(a, b, t));
+}
+
+}  // namespace
+
+SampleStream::SampleStream(const ToolTable& tools, const std::array<kin::Kinematics, kMaxChannels>& kins,
+                           int default_tool, double tol_mm, std::size_t batch_capacity, SweepSink& sink)
+    : tools_(tools), kins_(kins), default_tool_(tools.find(default_tool)), tol_(tol_mm), sink_(sink) {
+  batch_.reserve(batch_capacity);
+  for (Channel& c : ch_) c.run.reserve(kMaxRun + 1);
+}
+
+SampleStream::ChannelState SampleStream::channel(int i) const noexcept {
+  if (i < 0 || i >= kMaxChannels) return {};
+  const Channel& c = ch_[static_cast<std::size_t>(i)];
+  return {c.have && !c.run.empty(), c.tool, c.run.empty() ? geom::Pose{} : c.run.back()};
+}
+
+void SampleStream::push(const Channel& c, const geom::Pose& from, const geom::Pose& to) noexcept {
+  if (!c.tool.cuts()) return;
+  geom::SweepRef r;
+  r.shape = c.tool.shape;
+  r.turning = c.tool.turning;
+  r.from = from;
+  r.to = to;
+  r.id = static_cast<geom::MoveId>(c.seq & 0xFFFFFFFFU);
+  last_id_ = r.id;
+  sink_.on_sweep(r);
+  if (batch_.size() == batch_.capacity()) {  // capacity reserved at start-up: empty it now
+    sink_.on_batch_full(batch_);
+    batch_.clear();
+  }
+  batch_.push_back(r);
+}
+
+void SampleStream::flush(Channel& c) noexcept {
+  if (c.run.size() < 2) return;
+  push(c, c.run.front(), c.run.back());
+  const geom::Pose end = c.run.back();
+  c.run.clear();
+  c.run.push_back(end);
+}
+
+void SampleStream::flush_all() noexcept {
+  for (Channel& c : ch_) flush(c);
+}
+
+// The pending run starts afresh at axis values q with the channel's current tool.
+void SampleStream::restart(Channel& c, const kin::Kinematics& k, const nc::AxisVector& q) noexcept {
+  c.run.clear();
+  c.run.push_back(kin::tool_pose(k, q, c.tool.mount, c.tool.length_mm));
+}
+
+// Rotary axes moved the tool along a curve: n chords within the tolerance.
+void SampleStream::substeps(Channel& c, const kin::Kinematics& k, const nc::AxisVector& q, int n) noexcept {
+  flush(c);
+  const ToolRef& t = c.tool;
+  geom::Pose from = c.run.back();
+  for (int i = 1; i <= n; ++i) {
+    nc::AxisVector qi = q;
+    if (i < n)
+      for (int a = 0; a < nc::kAxes; ++a) qi[a] = c.q[a] + (q[a] - c.q[a]) * i / n;
+    const geom::Pose to = kin::tool_pose(k, qi, t.mount, t.length_mm);
+    push(c, from, to);
+    from = to;
+  }
+  c.run.clear();
+  c.run.push_back(from);
+  c.q = q;
+}
+
+// A straight move: extend the pending run when it stays straight, else cut it first.
+void SampleStream::extend(Channel& c, const kin::Kinematics& k, const nc::AxisVector& q) noexcept {
+  const geom::Pose p = kin::tool_pose(k, q, c.tool.mount, c.tool.length_mm);
+  if (c.run.size() >= 2) {
+    // Replace the run's straight sweep run[0]→last by run[0]→p only if the tool axis stays
+    // put and every sample of the run stays within the tolerance of the longer sweep.
+    bool straight = c.run.size() < kMaxRun && p.axis == c.run[0].axis && c.run.back().axis == c.run[0].axis;
+    for (std::size_t i = 1; straight && i < c.run.size(); ++i)
+      straight = dist_to_segment(c.run[i].tip, c.run[0].tip, p.tip) <= tol_;
+    if (!straight) flush(c);
+  }
+  c.run.push_back(p);
+  c.q = q;
+}
+
+void SampleStream::take(int channel, std::uint64_t seq, int tool, std::span<const double> sample,
+                        std::uint32_t mask) noexcept {
+  if (channel < 0 || channel >= kMaxChannels) return;
+  Channel& c = ch_[static_cast<std::size_t>(channel)];
+  const kin::Kinematics& k = kins_[static_cast<std::size_t>(channel)];
+  nc::AxisVector q = c.q;
+  for (int a = 0; a < nc::kAxes && a < static_cast<int>(sample.size()); ++a)
+    if (mask & (1U << a)) q[a] = sample[static_cast<std::size_t>(a)];
+  c.seq = seq;
+  const ToolRef t = tool >= 0 ? tools_.find(tool) : default_tool_;
+  if (c.have && !t.same(c.tool)) {  // tool change: the pending run belongs to the old tool
+    flush(c);
+    c.tool = t;
+    restart(c, k, c.q);
+  }
+  if (!c.have) {  // first sample: where the tool is; nothing to cut yet
+    c.have = true;
+    c.tool = t;
+    c.q = q;
+    restart(c, k, q);
+    return;
+  }
+  if (q == c.q) return;  // standing still
+  const int n = c.tool.cuts()
+                    ? kin::substeps(k, c.q, q, c.tool.mount, c.tool.length_mm, c.tool.reach_mm, tol_)
+                    : 1;
+  if (n > 1) substeps(c, k, q, n);
+  else extend(c, k, q);
+}
+
+}  // namespace lbr::motion
