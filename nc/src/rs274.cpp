@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <vector>
 
@@ -83,6 +84,42 @@ std::vector<double> numbers(const std::string& args) {
   return v;
 }
 
+bool machine_has_axis(const GcodeOptions& o, int a) {
+  switch (o.machine) {
+    case MachineKind::Mill3: return a <= Z;
+    case MachineKind::MillRotary: return a <= Z || o.rotary[static_cast<std::size_t>(a - A)];
+    case MachineKind::Lathe: return a == X || a == Z;
+    case MachineKind::LatheC: return a != A && a != B;
+  }
+  return false;
+}
+
+std::string machine_axes(const GcodeOptions& o) {
+  static const char* const kNames[kAxes] = {"X", "Y", "Z", "A", "B", "C"};
+  std::string s;
+  for (int a = 0; a < kAxes; ++a)
+    if (machine_has_axis(o, a)) s += std::string(s.empty() ? "" : " ") + kNames[a];
+  return "it has " + s;
+}
+
+// Standalone rs274 resynchronises its position after M6 from the last commanded program
+// position, ignoring a G43 in the same block, so the next move without Z would bring the new
+// tool's tip where the old one was. The real controller keeps the machine position (it reads
+// it back), which is what both front ends model; splitting "T2 M6 G43 H2" into "T2 M6" and
+// "G43 H2" (same line number) gives rs274 the same behaviour (docs/nc-frontend.md#frames).
+std::string split_m6_g43(const std::string& line, const std::string& n_word) {
+  static const std::regex m6(R"((^|[^0-9.])[Mm]\s*0*6(?![0-9.]))");
+  static const std::regex g43(R"([Gg]\s*0*43(?![0-9.])(\s*[Hh]\s*[-+]?[0-9.]+)?)");
+  std::string code = line;
+  const auto semi = code.find_first_of(";(");
+  const std::string head = code.substr(0, semi);
+  std::smatch mg;
+  if (!std::regex_search(head, m6) || !std::regex_search(head, mg, g43)) return line;
+  std::string rest = head.substr(0, static_cast<std::size_t>(mg.position(0))) +
+                     head.substr(static_cast<std::size_t>(mg.position(0) + mg.length(0)));
+  return rest + (semi == std::string::npos ? "" : code.substr(semi)) + "\n" + n_word + " " + mg.str(0);
+}
+
 std::string shell_quote(const std::string& s) {
   std::string q = "'";
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -122,6 +159,16 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
     for (int a = 0; a < kAxes; ++a) p[a] = v[first + a] * (a <= Z ? scale : 1.0);
     return p;
   };
+  // A motion that moves an axis the machine lacks is refused, as the built-in interpreter does.
+  auto check_axes = [&](const AxisVector& p) {
+    static const char* const kNames[kAxes] = {"X", "Y", "Z", "A", "B", "C"};
+    const AxisVector& cur = b.position();
+    for (int a = 0; a < kAxes; ++a)
+      if (!machine_has_axis(options, a) && std::abs(p[a] - cur[a]) > 1e-9)
+        fail(std::string("the program moves axis ") + kNames[a] + ", which the machine lacks (" +
+             machine_axes(options) + ")");
+    return p;
+  };
   while (std::getline(in, raw)) {
     const CanonLine c = split_canon(raw);
     if (!c.ok) continue;
@@ -153,12 +200,12 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
     } else if (cmd == "STRAIGHT_TRAVERSE") {
       const auto v = numbers(c.args);
       need(v, 6, cmd);
-      b.rapid(line, axes(v, 0));
+      b.rapid(line, check_axes(axes(v, 0)));
     } else if (cmd == "STRAIGHT_FEED") {
       const auto v = numbers(c.args);
       need(v, 6, cmd);
       if (feed <= 0.0) fail("STRAIGHT_FEED with zero feed rate");
-      b.feed(line, axes(v, 0), inverse ? feed : feed * scale, inverse);
+      b.feed(line, check_axes(axes(v, 0)), inverse ? feed : feed * scale, inverse);
     } else if (cmd == "ARC_FEED") {
       const auto v = numbers(c.args);
       need(v, 9, cmd);
@@ -168,6 +215,7 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
       end[ax.v] = v[1] * scale;
       end[ax.w] = v[5] * scale;
       end[A] = v[6], end[B] = v[7], end[C] = v[8];
+      (void)check_axes(end);
       if (std::abs(v[4]) > 1000.0) fail("ARC_FEED with more than 1000 turns");
       const int rot = static_cast<int>(std::lround(v[4]));
       if (rot == 0) fail("ARC_FEED with rotation 0");
@@ -198,8 +246,10 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
       else if (c.args.find("YZ") != std::string::npos) plane = Plane::YZ;
       else if (c.args.find("XY") != std::string::npos) plane = Plane::XY;
       else fail("plane " + c.args + " is not supported");
+    } else if (cmd.starts_with("START_SPEED_FEED_SYNC")) {
+      fail("spindle-synchronised motion (G33, G33.1, G76) is not supported: the tool path carries no spindle angle");
     } else if (cmd.find("PROBE") != std::string::npos || cmd == "RIGID_TAP" || cmd.find("NURBS") != std::string::npos ||
-               cmd.find("SPLINE") != std::string::npos || cmd == "START_SPEED_FEED_SYNCH" ||
+               cmd.find("SPLINE") != std::string::npos ||
                cmd.ends_with("_FEED") || cmd.ends_with("_TRAVERSE")) {
       fail("canonical command " + cmd + " is not supported");
     }
@@ -251,7 +301,8 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
         while (e < l.size() && std::isdigit(static_cast<unsigned char>(l[e]))) ++e;
         if (e > j + 1) i = e;
       }
-      numbered << prefix << 'N' << k << ' ' << l.substr(i) << '\n';
+      const std::string n_word = "N" + std::to_string(k);
+      numbered << prefix << n_word << ' ' << split_m6_g43(l.substr(i), n_word) << '\n';
     }
   }
 
@@ -274,7 +325,13 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
     if (!f) throw std::runtime_error("rs274: cannot write " + (dir / name).string());
   };
   write("program.ngc", numbered.str());
-  write("rs274.ini", "[RS274NGC]\nPARAMETER_FILE=rs274.var\n");
+  // Subroutines: the program's directory, then [nc] subroutine_path (as the built-in interpreter).
+  std::string sub_path = std::filesystem::absolute(std::filesystem::path(program_path).parent_path()).string();
+  for (const std::string& d : options.subroutine_path) sub_path += ":" + std::filesystem::absolute(d).string();
+  std::string ini = "[RS274NGC]\nPARAMETER_FILE=rs274.var\nSUBROUTINE_PATH=" + sub_path + "\n";
+  const bool lathe = options.machine == MachineKind::Lathe || options.machine == MachineKind::LatheC;
+  if (lathe) ini += std::string("RS274NGC_STARTUP_CODE=") + (options.diameter_mode ? "G7" : "G8") + "\n";
+  write("rs274.ini", ini);
   // Standalone rs274 works in inches internally: tool table and parameters are in inches.
   std::ostringstream tbl;
   tbl.precision(12);
@@ -314,20 +371,29 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
   const int rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (rc != 0) {
     // rs274 prints the error, then the offending block (with our N<line>).
+    // (print, ...) output comes before; the message is the line before the echoed block.
+    // A block in a subroutine file carries no N<line>: the last canonical line's N is used.
     std::istringstream in(out);
     std::string l, msg;
-    int line = 0;
-    bool after_msg = false;
+    std::vector<std::string> shown;
+    int line = 0, last_canon = 0;
     while (std::getline(in, l)) {
-      if (split_canon(l).ok || l == "executing") continue;
-      if (!after_msg) {
-        msg = l;
-        after_msg = true;
-      } else if (l.size() > 1 && l[0] == 'N' && std::isdigit(static_cast<unsigned char>(l[1]))) {
+      if (const CanonLine c = split_canon(l); c.ok) {
+        if (c.line > 0) last_canon = c.line;
+        continue;
+      }
+      if (l.starts_with("executing")) continue;
+      if (l.size() > 1 && l[0] == 'N' && std::isdigit(static_cast<unsigned char>(l[1])) && !shown.empty()) {
         line = static_cast<int>(std::min(std::strtol(l.c_str() + 1, nullptr, 10), 1000000000L));
         break;
       }
+      shown.push_back(l);
     }
+    for (auto it = shown.rbegin(); it != shown.rend() && msg.empty(); ++it)
+      if (it->find_first_not_of(" \t") != std::string::npos) msg = *it;
+    if (line == 0) line = last_canon;
+    for (std::size_t at = msg.find("program.ngc"); at != std::string::npos; at = msg.find("program.ngc", at + 1))
+      msg.replace(at, std::string("program.ngc").size(), program_path);
     if (rc == 124) msg = "did not finish within 120 s";
     if (msg.empty()) msg = "failed with exit status " + std::to_string(rc);
     throw ParseError(program_path, line, "rs274: " + msg);
