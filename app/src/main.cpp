@@ -135,18 +135,10 @@ int run_channels_command(const BatchOptions& o, const app::Profile& profile, con
   if (!o.program.empty())
     throw std::runtime_error("--program: profile " + profile.source +
                              " defines [[channel]] tables; their programs come from channel.program");
-  const std::string dir = std::filesystem::path(profile.source).parent_path().string();
-  std::vector<app::ChannelPath> channels;
+  const std::vector<app::ChannelPath> channels = app::load_channel_paths(profile, interpreter_of(o.interpreter));
   std::string names;
-  for (const app::Channel& c : profile.channels) {
-    if (c.program.empty()) throw std::runtime_error(profile.source + ": channel '" + c.name + "' has no program");
-    const std::filesystem::path prog = std::filesystem::path(c.program).is_absolute()
-                                           ? std::filesystem::path(c.program)
-                                           : std::filesystem::path(dir) / c.program;
-    app::Profile per = profile;
-    per.g54_origin_mm = c.g54_origin_mm;
-    channels.push_back({c.name, app::load_toolpath(prog.string(), per, interpreter_of(o.interpreter)), c.kin});
-    spdlog::info("channel {}: program {} ({} segments)", c.name, prog.string(), channels.back().path.segments.size());
+  for (const app::ChannelPath& c : channels) {
+    spdlog::info("channel {}: program {} ({} segments)", c.name, c.path.source, c.path.segments.size());
     names += (names.empty() ? "" : "+") + c.name;
   }
   app::Progress progress;
@@ -187,8 +179,17 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
     throw gfx::DisplayError("lbrsim view needs a display (DISPLAY / WAYLAND_DISPLAY are not set); "
                             "headless: `xvfb-run -a lbrsim view --hidden ...`");
   const app::Profile profile = batch_profile(o);
-  const nc::Toolpath path =
-      o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
+  std::vector<app::ChannelPath> channels;
+  if (!profile.channels.empty()) {
+    if (!o.program.empty())
+      throw std::runtime_error("--program: profile " + profile.source +
+                               " defines [[channel]] tables; their programs come from channel.program");
+    channels = app::load_channel_paths(profile, interpreter_of(o.interpreter));
+  } else {
+    channels.push_back({"", o.program.empty() ? app::demo_toolpath()
+                                              : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter)),
+                        profile.kin});
+  }
   app::ViewOptions vo;
   vo.render = render_config(o, v);
   vo.animate = v.animate;
@@ -196,7 +197,7 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
   vo.hidden = v.hidden;
   vo.frames = v.frames;
   vo.quiet = o.quiet;
-  return app::run_view(profile, path, vo);
+  return app::run_view(profile, channels, vo);
 }
 
 int run_batch_command(const BatchOptions& o) {

@@ -57,6 +57,20 @@ nc::Toolpath load_toolpath(const std::string& path, const Profile& profile, Inte
   throw std::runtime_error(path + ": unknown program type '" + ext + "' (expected .moves, .ngc, .nc, .gcode or .tap)");
 }
 
+std::vector<ChannelPath> load_channel_paths(const Profile& profile, Interpreter interpreter) {
+  const std::filesystem::path dir = std::filesystem::path(profile.source).parent_path();
+  std::vector<ChannelPath> channels;
+  for (const Channel& c : profile.channels) {
+    if (c.program.empty()) throw std::runtime_error(profile.source + ": channel '" + c.name + "' has no program");
+    const std::filesystem::path prog =
+        std::filesystem::path(c.program).is_absolute() ? std::filesystem::path(c.program) : dir / c.program;
+    Profile per = profile;
+    per.g54_origin_mm = c.g54_origin_mm;
+    channels.push_back({c.name, load_toolpath(prog.string(), per, interpreter), c.kin});
+  }
+  return channels;
+}
+
 nc::Toolpath demo_toolpath() { return nc::parse_movelist(kDemoProgram, "<built-in demo-pocket.moves>"); }
 
 std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program) {

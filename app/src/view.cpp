@@ -1,5 +1,6 @@
 #include "app/view.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -38,47 +39,43 @@ std::vector<gfx::ToolState> final_tools(const Profile& profile, const nc::Toolpa
   return {gfx::tool_state(it->second, tool, pose)};
 }
 
+namespace {
+
+std::vector<ChannelPath> one_channel(const Profile& profile, const nc::Toolpath& path) {
+  return {ChannelPath{"", path, profile.kin}};
+}
+
+bool has_tool_axes(const std::vector<ChannelPath>& channels) {
+  for (const ChannelPath& c : channels)
+    for (const nc::Segment& s : c.path.segments)
+      if (s.has_tool_axis) return true;
+  return false;
+}
+
+}  // namespace
+
+geom::SolidSpec stream_solid_spec(const Profile& profile, const std::vector<ChannelPath>& channels) {
+  motion::ToolTable tools(tool_config(profile), profile.solid.chord_tol_mm, profile.source);
+  for (const ChannelPath& c : channels) tools.require_path(c.path);
+  return batch_solid_spec(profile, tools);
+}
+
 PathStreamer::PathStreamer(const Profile& profile, const nc::Toolpath& path, geom::LbrSolid& solid,
                            gfx::SolidExchange& ex, StreamOptions opt)
-    : solid_(solid), ex_(ex), opt_(opt) {
-  // Sample the path at the controller period under the batch runner's motion model.
-  double t = 0;
-  geom::Pose pose = pose_at(path.start, path.start_axis);
-  nc::AxisVector pos = path.start;
-  samples_.push_back({0.0, pose, path.start_tool, 0});
-  for (std::size_t i = 0; i < path.segments.size(); ++i) {
-    const nc::Segment& s = path.segments[i];
-    if (s.kind == nc::SegmentKind::Dwell) t += s.dwell_s;
-    if (s.kind == nc::SegmentKind::ToolChange) t += profile.tool_change_s;
-    if (!is_motion(s)) continue;
-    if (!shapes_.count(s.tool)) {
-      const auto it = profile.tools.find(s.tool);
-      if (it == profile.tools.end())
-        throw std::runtime_error(path.source + ":" + std::to_string(s.line) + ": tool " + std::to_string(s.tool) +
-                                 " is not in the tool table of " + profile.source);
-      shapes_.emplace(s.tool, geom::CutterShape::build(it->second, profile.solid.chord_tol_mm));
-      tools_.emplace(s.tool, it->second);
-    }
-    geom::Pose next = pose_at(s.end, s.tool_axis);
-    if (!s.has_tool_axis) next.axis = pose.axis;
-    const double len = std::hypot(s.end[nc::X] - pos[nc::X], s.end[nc::Y] - pos[nc::Y], s.end[nc::Z] - pos[nc::Z]);
-    const double rate = s.kind == nc::SegmentKind::Rapid ? profile.rapid_mm_per_min : s.feed_mm_per_min;
-    const double d = rate > 0 ? len / rate * 60.0 : 0.0;
-    const int n = std::max(1, static_cast<int>(std::ceil(d / opt_.sample_period_s)));
-    for (int k = 1; k <= n; ++k) {
-      const double f = static_cast<double>(k) / n;
-      samples_.push_back({t + f * d, {geom::lerp(pose.tip, next.tip, f), geom::lerp(pose.axis, next.axis, f)}, s.tool,
-                          static_cast<geom::MoveId>(i + 1)});
-    }
-    t += d;
-    pose = next;
-    pos = s.end;
-  }
+    : PathStreamer(profile, one_channel(profile, path), solid, ex, opt) {}
+
+PathStreamer::PathStreamer(const Profile& profile, const std::vector<ChannelPath>& channels, geom::LbrSolid& solid,
+                           gfx::SolidExchange& ex, StreamOptions opt)
+    : tools_(tool_config(profile), profile.solid.chord_tol_mm, profile.source), solid_(solid), ex_(ex), opt_(opt) {
+  for (const ChannelPath& c : channels) tools_.require_path(c.path);
+  nc::EmulatorLimits limits = emulator_limits(profile);
+  limits.sample_period_ms = opt_.sample_period_s * 1e3;
+  motion::PlannedSweeps plan = motion::plan_channels(tools_, channels, limits, !has_tool_axes(channels));
+  sweeps_ = std::move(plan.sweeps);
+  duration_s_ = plan.machining_time_s;
 }
 
 PathStreamer::~PathStreamer() { stop(); }
-
-double PathStreamer::duration_s() const noexcept { return samples_.empty() ? 0.0 : samples_.back().t; }
 
 void PathStreamer::start() {
   if (thread_.joinable()) return;
@@ -90,6 +87,20 @@ void PathStreamer::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
+std::size_t PathStreamer::tools_at(std::size_t upto, std::array<gfx::ToolState, gfx::kMaxTools>& out) const {
+  std::array<bool, gfx::kMaxTools> seen{};
+  std::size_t n = 0;
+  for (std::size_t i = upto; i-- > 0 && n < out.size();) {
+    const motion::TimedSweep& s = sweeps_[i];
+    const auto ch = static_cast<std::size_t>(s.channel);
+    if (ch >= seen.size() || seen[ch]) continue;
+    seen[ch] = true;
+    if (s.ref.shape != nullptr) out[n++] = gfx::tool_state(s.ref.shape->tool, s.tool, s.ref.to, s.channel);
+    if (std::all_of(seen.begin(), seen.end(), [](bool b) { return b; })) break;
+  }
+  return n;
+}
+
 void PathStreamer::loop() {
   using clock = std::chrono::steady_clock;
   std::vector<geom::SweepRef> batch;
@@ -99,39 +110,38 @@ void PathStreamer::loop() {
   const auto start = clock::now();
   const auto tick = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(opt_.tick_s));
   auto next = start;
-  std::size_t i = 1;
+  std::size_t i = 0;
   gfx::LiveStats stats;
-  std::vector<gfx::ToolState> tools(1);
+  std::array<gfx::ToolState, gfx::kMaxTools> tools{};
+  std::size_t tool_count = 0;
   geom::MoveId last = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
     const double sim = std::chrono::duration<double>(clock::now() - start).count() * opt_.speed;
     batch.clear();
-    while (i < samples_.size() && samples_[i].t <= sim) {
-      const Sample& a = samples_[i - 1];
-      const Sample& b = samples_[i];
-      batch.push_back({&shapes_.at(b.tool), a.pose, b.pose, b.id});
-      ex_.add_path_point(b.pose.tip);
-      last = b.id;
-      ++i;
+    for (; i < sweeps_.size() && sweeps_[i].t_s <= sim; ++i) {
+      batch.push_back(sweeps_[i].ref);
+      ex_.add_path_point(sweeps_[i].ref.to.tip);
+      last = sweeps_[i].ref.id;
     }
     if (!batch.empty()) {
       const auto t0 = clock::now();
       solid_.subtract(batch, ws);
       batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
       batches_.fetch_add(1, std::memory_order_relaxed);
-      const Sample& cur = samples_[i - 1];
-      tools[0] = gfx::tool_state(tools_.at(cur.tool), cur.tool, cur.pose);
-      stats.lag_ms = std::max(0.0, (std::chrono::duration<double>(clock::now() - start).count() * opt_.speed - cur.t) /
+      tool_count = tools_at(i, tools);
+      const double t_cur = sweeps_[i - 1].t_s;
+      stats.lag_ms = std::max(0.0, (std::chrono::duration<double>(clock::now() - start).count() * opt_.speed - t_cur) /
                                        opt_.speed * 1000.0);
       stats.sample_rate_hz = opt_.speed / opt_.sample_period_s;
       stats.samples = i;
     }
+    const std::span<const gfx::ToolState> shown(tools.data(), tool_count);
     // Publish every tick: a refused publish (render side busy) loses nothing.
-    (void)ex_.publish(solid_, tools, last, stats);
-    if (i >= samples_.size()) {
+    (void)ex_.publish(solid_, shown, last, stats);
+    if (i >= sweeps_.size()) {
       // Make sure the final state gets out.
       while (solid_.dirty_count() > 0 && !stop_.load(std::memory_order_relaxed)) {
-        if (ex_.publish(solid_, tools, last, stats)) break;
+        if (ex_.publish(solid_, shown, last, stats)) break;
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
       }
       break;
@@ -142,38 +152,48 @@ void PathStreamer::loop() {
   done_.store(true, std::memory_order_release);
 }
 
-int run_view(const Profile& profile, const nc::Toolpath& path, const ViewOptions& opt) {
-  gfx::RenderThreadConfig rc = opt.render;
-  if (opt.frames) rc.max_frames = opt.frames;
-  gfx::Window win(rc.width, rc.height, !opt.hidden, "lbrsim — " + path.source);
-  if (!opt.quiet) spdlog::info("OpenGL: {}", gfx::Window::gl_description());
+namespace {
 
-  std::unique_ptr<geom::LbrSolid> solid;
-  gfx::SolidExchange ex(std::max<std::size_t>(8192, path.segments.size() + 2));
-  std::unique_ptr<PathStreamer> streamer;
-  if (opt.animate) {
-    geom::SolidSpec spec = profile.solid;
-    if (profile.regions_auto) {
-      double dmax = 1.0;
-      for (const nc::Segment& s : path.segments)
-        if (is_motion(s) && profile.tools.count(s.tool)) dmax = std::max(dmax, profile.tools.at(s.tool).diameter_mm);
-      std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, dmax);
-    }
-    solid = std::make_unique<geom::LbrSolid>(spec);
-    solid->clear_dirty();
-    streamer = std::make_unique<PathStreamer>(profile, path, *solid, ex, opt.stream);
-    if (!opt.quiet) spdlog::info("streaming {:.1f} s of machining at {}x", streamer->duration_s(), opt.stream.speed);
-  } else {
-    BatchResult r = run_batch(profile, path);
-    solid = std::make_unique<geom::LbrSolid>(std::move(r.solid));
-    solid->clear_dirty();
-    // One snapshot with the tool at its final pose and the programmed path (segment ends).
-    geom::Vec3 p{path.start[nc::X], path.start[nc::Y], path.start[nc::Z]};
-    ex.add_path_point(p);
+// The batch result with the tool at its final pose and the programmed path (segment ends).
+std::unique_ptr<geom::LbrSolid> publish_batch_result(const Profile& profile, const std::vector<ChannelPath>& channels,
+                                                     gfx::SolidExchange& ex) {
+  BatchResult r = channels.size() == 1 ? run_batch(profile, channels.front().path) : run_batch_channels(profile, channels);
+  auto solid = std::make_unique<geom::LbrSolid>(std::move(r.solid));
+  solid->clear_dirty();
+  std::size_t segments = 0;
+  for (const ChannelPath& c : channels) {
+    const nc::Toolpath& path = c.path;
+    segments += path.segments.size();
+    ex.add_path_point({path.start[nc::X], path.start[nc::Y], path.start[nc::Z]});
     for (const nc::Segment& s : path.segments)
       if (is_motion(s)) ex.add_path_point({s.end[nc::X], s.end[nc::Y], s.end[nc::Z]});
-    const auto tools = final_tools(profile, path);
-    (void)ex.publish(*solid, tools, static_cast<geom::MoveId>(path.segments.size()), gfx::LiveStats{});
+  }
+  const auto tools = channels.size() == 1 ? final_tools(profile, channels.front().path) : std::vector<gfx::ToolState>{};
+  (void)ex.publish(*solid, tools, static_cast<geom::MoveId>(segments), gfx::LiveStats{});
+  return solid;
+}
+
+}  // namespace
+
+int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, const ViewOptions& opt) {
+  gfx::RenderThreadConfig rc = opt.render;
+  if (opt.frames) rc.max_frames = opt.frames;
+  const std::string title = channels.size() == 1 ? channels.front().path.source : profile.source;
+  gfx::Window win(rc.width, rc.height, !opt.hidden, "lbrsim — " + title);
+  if (!opt.quiet) spdlog::info("OpenGL: {}", gfx::Window::gl_description());
+
+  std::size_t segments = 0;
+  for (const ChannelPath& c : channels) segments += c.path.segments.size();
+  std::unique_ptr<geom::LbrSolid> solid;
+  gfx::SolidExchange ex(std::max<std::size_t>(8192, segments + 2 * channels.size()));
+  std::unique_ptr<PathStreamer> streamer;
+  if (opt.animate) {
+    solid = std::make_unique<geom::LbrSolid>(stream_solid_spec(profile, channels));
+    solid->clear_dirty();
+    streamer = std::make_unique<PathStreamer>(profile, channels, *solid, ex, opt.stream);
+    if (!opt.quiet) spdlog::info("streaming {:.1f} s of machining at {}x", streamer->duration_s(), opt.stream.speed);
+  } else {
+    solid = publish_batch_result(profile, channels, ex);
   }
 
   gfx::RenderThread rt(win, ex, *solid, rc);

@@ -23,6 +23,12 @@ enum class Interpreter { Builtin, Rs274 };
 [[nodiscard]] nc::Toolpath load_toolpath(const std::string& path, const Profile& profile,
                                          Interpreter interpreter = Interpreter::Builtin);
 
+// The channels of a profile with [[channel]] tables, each with its program (channel.program,
+// relative to the profile's folder) loaded with that channel's G54 origin. Throws
+// std::runtime_error for a channel without a program, or like load_toolpath().
+[[nodiscard]] std::vector<ChannelPath> load_channel_paths(const Profile& profile,
+                                                          Interpreter interpreter = Interpreter::Builtin);
+
 // Writes emulator samples as CSV (columns in docs/nc-frontend.md#samples-csv). Returns the
 // number of samples. Throws std::runtime_error naming the path on I/O failure.
 std::uint64_t write_samples_csv(const std::string& path, nc::Emulator& emulator);

@@ -5,7 +5,7 @@
 
 #include <atomic>
 #include <cstdint>
-#include <map>
+#include <array>
 #include <memory>
 #include <string>
 #include <thread>
@@ -16,6 +16,8 @@
 #include "gfx/capture.hpp"
 #include "gfx/exchange.hpp"
 #include "gfx/render_thread.hpp"
+#include "motion/path_sweeps.hpp"
+#include "motion/tool_table.hpp"
 #include "nc/toolpath.hpp"
 
 namespace lbr::app {
@@ -29,35 +31,39 @@ struct StreamOptions {
   double tick_s = 0.010;          // geometry batch period (wall) [s]
 };
 
-// Streams a tool path through `solid` on a geometry thread: each tick, the samples due by
-// then are subtracted as one batch and published (gfx::SolidExchange contract). The solid
-// belongs to that thread between start() and stop()/done().
+// Streams the channels' tool paths through `solid` on a geometry thread: each tick, the
+// sweeps due by then are subtracted as one batch and published (gfx::SolidExchange
+// contract). The sweeps are those of `lbrsim batch --sampled` (motion::plan_channels: the
+// machine emulator's samples every sample_period_s through each channel's kinematics), so
+// every machine kind animates, and the final solid is the batch one; programs with explicit
+// tool axes (CL data) stream their segments at the emulator's end times instead. The solid
+// belongs to that thread between start() and stop()/done(). Setup throws like batch (e.g. a
+// tool that is not in the tool table, naming the program line).
 class PathStreamer {
  public:
   PathStreamer(const Profile& profile, const nc::Toolpath& path, geom::LbrSolid& solid, gfx::SolidExchange& ex,
                StreamOptions opt = {});
+  PathStreamer(const Profile& profile, const std::vector<ChannelPath>& channels, geom::LbrSolid& solid,
+               gfx::SolidExchange& ex, StreamOptions opt = {});
   ~PathStreamer();
   PathStreamer(const PathStreamer&) = delete;
   PathStreamer& operator=(const PathStreamer&) = delete;
   void start();
   void stop();
   [[nodiscard]] bool done() const noexcept { return done_.load(std::memory_order_acquire); }
-  [[nodiscard]] double duration_s() const noexcept;  // simulated machining time
+  [[nodiscard]] double duration_s() const noexcept { return duration_s_; }  // simulated machining time
   [[nodiscard]] std::uint64_t batches() const noexcept { return batches_.load(std::memory_order_relaxed); }
   // Wall time of each subtract() batch [ms] (valid after stop()/done()).
   [[nodiscard]] const std::vector<double>& batch_ms() const noexcept { return batch_ms_; }
 
  private:
-  struct Sample {
-    double t;
-    geom::Pose pose;
-    int tool;
-    geom::MoveId id;
-  };
   void loop();
-  std::map<int, geom::CutterShape> shapes_;
-  std::map<int, geom::Tool> tools_;
-  std::vector<Sample> samples_;
+  // Tools to draw: each channel's milling tool at the end of its latest sweep up to `upto`.
+  std::size_t tools_at(std::size_t upto, std::array<gfx::ToolState, gfx::kMaxTools>& out) const;
+
+  motion::ToolTable tools_;
+  std::vector<motion::TimedSweep> sweeps_;
+  double duration_s_ = 0.0;
   geom::LbrSolid& solid_;
   gfx::SolidExchange& ex_;
   StreamOptions opt_;
@@ -66,6 +72,9 @@ class PathStreamer {
   std::atomic<std::uint64_t> batches_{0};
   std::vector<double> batch_ms_;
 };
+
+// The stock `lbrsim batch` would use for these channels (regions = auto sized like batch).
+[[nodiscard]] geom::SolidSpec stream_solid_spec(const Profile& profile, const std::vector<ChannelPath>& channels);
 
 struct ViewOptions {
   gfx::RenderThreadConfig render;
@@ -76,8 +85,9 @@ struct ViewOptions {
   bool quiet = false;
 };
 
-// `lbrsim view`: the render thread on a window, fed by a batch result or a streamed run.
-// Returns the process exit code.
-int run_view(const Profile& profile, const nc::Toolpath& path, const ViewOptions& opt);
+// `lbrsim view`: the render thread on a window, fed by a batch result or a streamed run of
+// the channels (one for a single program; a profile's [[channel]] tables). Returns the
+// process exit code.
+int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, const ViewOptions& opt);
 
 }  // namespace lbr::app
