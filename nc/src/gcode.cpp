@@ -468,7 +468,9 @@ class Interpreter {
       polar_ = code10(*gw[kPolar]) == 121;
     }
     if (gw[kLathe]) {
-      if (opt_.machine != MachineKind::Lathe && opt_.machine != MachineKind::LatheC)
+      // G8 (radius mode) is every mill's state; LinuxCNC accepts it anywhere.
+      const bool lathe = opt_.machine == MachineKind::Lathe || opt_.machine == MachineKind::LatheC;
+      if (!lathe && code10(*gw[kLathe]) == 70)
         fail("'" + gw[kLathe]->text + "' (lathe " + (code10(*gw[kLathe]) == 70 ? "diameter" : "radius") +
              " mode) needs machine kind lathe");
       diameter_mode_ = code10(*gw[kLathe]) == 70;
@@ -504,9 +506,9 @@ class Interpreter {
     if (gw[kArcDistance]) arc_absolute_ = code10(*gw[kArcDistance]) == 901;
     if (gw[kRetract]) retract_to_initial_ = code10(*gw[kRetract]) == 980;
 
-    // Axis words must exist on the machine.
+    // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing).
     for (int a = 0; a < kAxes; ++a)
-      if (has(b, kAxisLetters[a]) && !axis_allowed(a))
+      if (has(b, kAxisLetters[a]) && !axis_allowed(a) && g10 == 0)
         fail("word '" + text(b, kAxisLetters[a]) + "' needs an axis the machine lacks (machine kind " + machine_name() + ")");
 
     // 8. G10, G28/G30, G53; 9. motion

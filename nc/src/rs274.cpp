@@ -241,6 +241,11 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
       selected = static_cast<int>(std::lround(v[0]));
     } else if (cmd == "CHANGE_TOOL") {
       b.tool_change(line, selected);
+    } else if (cmd == "CHANGE_TOOL_NUMBER") {  // M61 Q: this tool is in the spindle now
+      const auto v = numbers(c.args);
+      need(v, 1, cmd);
+      selected = static_cast<int>(std::lround(v[0]));
+      b.tool_change(line, selected);
     } else if (cmd == "SELECT_PLANE") {
       if (c.args.find("XZ") != std::string::npos) plane = Plane::ZX;
       else if (c.args.find("YZ") != std::string::npos) plane = Plane::YZ;
