@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
+#include <sstream>
 
 namespace lbr::nc::detail {
 
@@ -246,7 +247,11 @@ int ExprReader::param_number(std::string_view s, std::size_t& pos) {
   const double v = value(s, pos);
   const double r = std::nearbyint(v);
   if (std::abs(v - r) > 1e-4 || r < 1 || r > kMaxNumberedParam)
-    throw ExprError("parameter number " + std::to_string(v) + " is not an integer in [1, " +
+    throw ExprError("parameter number " + [&] {
+      std::ostringstream o;
+      o << v;
+      return o.str();
+    }() + " is not an integer in [1, " +
                     std::to_string(kMaxNumberedParam) + "]");
   return static_cast<int>(r);
 }

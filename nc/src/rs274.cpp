@@ -329,13 +329,21 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
     f << content;
     if (!f) throw std::runtime_error("rs274: cannot write " + (dir / name).string());
   };
-  write("program.ngc", numbered.str());
+  // Lathes start in the profile's diameter/radius mode: standalone rs274 ignores the INI's
+  // RS274NGC_STARTUP_CODE, so a G7/G8 block without a line number goes first (after a
+  // leading '%').
+  std::string prog = numbered.str();
+  if (options.machine == MachineKind::Lathe || options.machine == MachineKind::LatheC) {
+    const std::string mode = options.diameter_mode ? "G7\n" : "G8\n";
+    const std::size_t first = prog.find_first_not_of(" \t\r\n");
+    if (first != std::string::npos && prog[first] == '%') prog.insert(prog.find('\n', first) + 1, mode);
+    else prog.insert(0, mode);
+  }
+  write("program.ngc", prog);
   // Subroutines: the program's directory, then [nc] subroutine_path (as the built-in interpreter).
   std::string sub_path = std::filesystem::absolute(std::filesystem::path(program_path).parent_path()).string();
   for (const std::string& d : options.subroutine_path) sub_path += ":" + std::filesystem::absolute(d).string();
   std::string ini = "[RS274NGC]\nPARAMETER_FILE=rs274.var\nSUBROUTINE_PATH=" + sub_path + "\n";
-  const bool lathe = options.machine == MachineKind::Lathe || options.machine == MachineKind::LatheC;
-  if (lathe) ini += std::string("RS274NGC_STARTUP_CODE=") + (options.diameter_mode ? "G7" : "G8") + "\n";
   write("rs274.ini", ini);
   // Standalone rs274 works in inches internally: tool table and parameters are in inches.
   std::ostringstream tbl;
