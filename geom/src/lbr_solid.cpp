@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "chain_outline.hpp"
 #include "polygon_ops.hpp"
 
 namespace lbr::geom {
@@ -346,6 +347,8 @@ void LbrSolid::prepare_shared(std::span<const SweepRef> batch, SubtractShared& s
   merge_collinear(batch, sh.merged);
   sh.sweeps.clear();
   sh.sweep_id.clear();
+  sh.runs.clear();
+  bool run_open = false;  // the last item pushed is a sweep that the next one may continue
   sh.lathe.clear();
   sh.lathe_id.clear();
   sh.chain_count = 0;
@@ -377,6 +380,7 @@ void LbrSolid::prepare_shared(std::span<const SweepRef> batch, SubtractShared& s
         zlo = std::min(zlo, c.z);
         zhi = std::max(zhi, c.z + s.shape->height());
         i = j - 1;
+        run_open = false;
         continue;
       }
     }
@@ -385,10 +389,18 @@ void LbrSolid::prepare_shared(std::span<const SweepRef> batch, SubtractShared& s
       sh.lathe_id.push_back(s.id);
       zlo = std::min(zlo, sh.lathe.back().z_min());
       zhi = std::max(zhi, sh.lathe.back().z_max());
+      run_open = false;
       continue;
     }
     sh.sweeps.emplace_back(*s.shape, s.from, s.to);
     sh.sweep_id.push_back(s.id);
+    const auto si = static_cast<std::uint32_t>(sh.sweeps.size() - 1);
+    const bool vertical = sh.sweeps.back().vertical();
+    if (vertical && run_open && merged[i - 1].shape == s.shape && merged[i - 1].to.tip == s.from.tip)
+      sh.runs.back().second = si + 1;
+    else
+      sh.runs.emplace_back(si, si + 1);  // (a tilted move is a run of one: its section as it is)
+    run_open = vertical;
     zlo = std::min(zlo, sh.sweeps.back().z_min());
     zhi = std::max(zhi, sh.sweeps.back().z_max());
   }
@@ -621,32 +633,7 @@ void LbrSolid::build_level(int level, const SubtractShared& sh, SubtractWorkspac
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
-  Capsule prev_core;  // inside the last vertical section of this level (trim_covered())
-  for (std::size_t si = 0; si < sh.sweeps.size(); ++si) {
-    const Sweep& sw = sh.sweeps[si];
-    if (zc < sw.z_min() || zc > sw.z_max()) continue;
-    const std::size_t before = ls.paths.size();
-    sw.section(zc, ls.paths, ws.scratch);
-    // Consecutive moves overlap: the vertices of this section inside the previous vertical
-    // section's capsule add edges to the clip but remove nothing more (trim_covered()).
-    if (sw.vertical() && ls.paths.size() == before + 1) {
-      if (prev_core.valid()) {
-        const std::size_t vertices = ls.paths.back().size();
-        if (!trim_covered(ls.paths.back(), prev_core, ws.trim_flags)) {
-          ls.paths.pop_back();
-          ++stats.sections_trimmed;
-        } else if (ls.paths.back().size() != vertices) {
-          ++stats.sections_trimmed;
-        }
-      }
-      if (ws.scratch.core.valid()) prev_core = ws.scratch.core;
-    }
-    for (std::size_t k = before; k < ls.paths.size(); ++k) {
-      ls.box.push_back(bounds_of(ls.paths[k]));
-      ls.id.push_back(sh.sweep_id[si]);
-      ls.all.add(ls.box.back());
-    }
-  }
+  for (const auto& run : sh.runs) build_run_sections(zc, run, sh, ws, ls, stats);
   ls.chain.assign(ls.paths.size(), kNoChain);
   // Chains: one entry for the whole offset (outer contours and holes); a clip adds its
   // piece cut to the region (SubtractShared::Offset).
@@ -698,6 +685,70 @@ void LbrSolid::build_level(int level, const SubtractShared& sh, SubtractWorkspac
   ls.ix1 = interval_of(xs_, ls.all.x1);
   ls.iy0 = interval_of(ys_, ls.all.y0);
   ls.iy1 = interval_of(ys_, ls.all.y1);
+}
+
+// The sections of one run of sweeps on plane zc: consecutive moves whose sections share
+// their joint disk become one outline (chain_outline.hpp); the others are emitted one by
+// one, trimmed where the previous vertical section covers them (trim_covered()).
+void LbrSolid::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
+                                  SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const {
+  Capsule prev_core;  // inside the last single vertical section of this run (trim_covered())
+  auto push_boxes = [&](std::size_t before, MoveId id) {
+    for (std::size_t k = before; k < ls.paths.size(); ++k) {
+      ls.box.push_back(bounds_of(ls.paths[k]));
+      ls.id.push_back(id);
+      ls.all.add(ls.box.back());
+    }
+  };
+  std::uint32_t si = run.first;
+  while (si < run.second) {
+    const Sweep& sw = sh.sweeps[si];
+    if (zc < sw.z_min() || zc > sw.z_max()) {
+      ++si;
+      continue;
+    }
+    // Joined outline from si, when si and at least the next move share their joint disk.
+    if (run.second - si >= 2) {
+      // One angle grid along the run: the tool's full radius sets it.
+      const int grid = Sweep::circle_segments(sw.shape().radius(), sw.shape().chord_tol_mm);
+      if (ws.caps.size() < run.second - si) ws.caps.resize(run.second - si);
+      std::size_t count = 0;
+      while (si + count < run.second && sh.sweeps[si + count].section_caps(zc, grid, ws.scratch, ws.caps[count]) &&
+             (count == 0 || (ws.caps[count - 1].c1.x == ws.caps[count].c0.x && ws.caps[count - 1].c1.y == ws.caps[count].c0.y &&
+                             ws.caps[count - 1].rho1 == ws.caps[count].rho0)))
+        ++count;
+      if (count >= 2) {
+        const std::size_t before = ls.paths.size();
+        detail::append_outline(std::span<const MoveCaps>(ws.caps.data(), count), grid, ws.scratch.unit_circle(grid),
+                               ws.outline, ls.paths, ws.scratch.spare);
+        MoveId id = 0;
+        for (std::size_t k = 0; k < count; ++k) id = std::max(id, sh.sweep_id[si + k]);
+        push_boxes(before, id);
+        stats.sections_joined += count;
+        prev_core = Capsule{};
+        si += static_cast<std::uint32_t>(count);
+        continue;
+      }
+    }
+    const std::size_t before = ls.paths.size();
+    sw.section(zc, ls.paths, ws.scratch);
+    // Consecutive moves overlap: the vertices of this section inside the previous vertical
+    // section's capsule add edges to the clip but remove nothing more (trim_covered()).
+    if (sw.vertical() && ls.paths.size() == before + 1) {
+      if (prev_core.valid()) {
+        const std::size_t vertices = ls.paths.back().size();
+        if (!trim_covered(ls.paths.back(), prev_core, ws.trim_flags)) {
+          ls.paths.pop_back();
+          ++stats.sections_trimmed;
+        } else if (ls.paths.back().size() != vertices) {
+          ++stats.sections_trimmed;
+        }
+      }
+      if (ws.scratch.core.valid()) prev_core = ws.scratch.core;
+    }
+    push_boxes(before, sh.sweep_id[si]);
+    ++si;
+  }
 }
 
 // The chain offset `o` cut to `region` (grown by 1 mm); the first thread that needs a piece

@@ -218,35 +218,45 @@ std::size_t Sweep::section(double z_mm, Paths& out, SectionScratch& scratch) con
   return vertical_ ? section_vertical(z_mm, out, scratch) : section_general(z_mm, out, scratch);
 }
 
-std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) const {
+bool Sweep::section_disks(double zc, SectionScratch& sc) const {
   const CutterShape& s = *shape_;
   const double H = s.height();
   const double z0 = from_.tip.z, z1 = to_.tip.z, dz = z1 - z0;
   sc.disks.clear();
+  // The end poses are taken as given (not as from + 1·(to - from)), so that a move's end
+  // disk and the next move's start disk are the same disk to the last bit.
   auto disk_at = [&](double t) {
-    const double h = zc - (z0 + t * dz);
-    sc.disks.push_back({from_.tip.x + t * (to_.tip.x - from_.tip.x), from_.tip.y + t * (to_.tip.y - from_.tip.y),
-                        s.radius_at(std::clamp(h, 0.0, H))});
+    const int role = t == 0.0 ? 1 : t == 1.0 ? 2 : 0;
+    const double x = role == 1 ? from_.tip.x : role == 2 ? to_.tip.x : from_.tip.x + t * (to_.tip.x - from_.tip.x);
+    const double y = role == 1 ? from_.tip.y : role == 2 ? to_.tip.y : from_.tip.y + t * (to_.tip.y - from_.tip.y);
+    const double z = role == 1 ? z0 : role == 2 ? z1 : z0 + t * dz;
+    sc.disks.push_back({x, y, s.radius_at(std::clamp(zc - z, 0.0, H)), 0.0, role});
   };
   if (dz == 0.0) {
     const double h = zc - z0;
-    if (h < 0.0 || h > H) return 0;
+    if (h < 0.0 || h > H) return false;
     disk_at(0.0);
     disk_at(1.0);
-  } else {
-    // Parameter interval where the plane meets the cutting part: 0 <= zc - z(t) <= H.
-    double ta = (zc - z0) / dz, tb = (zc - H - z0) / dz;
-    if (ta > tb) std::swap(ta, tb);
-    ta = std::max(ta, 0.0);
-    tb = std::min(tb, 1.0);
-    if (ta > tb) return 0;
-    disk_at(ta);
-    for (const auto& st : s.stations) {
-      const double t = (zc - st.h - z0) / dz;
-      if (t > ta && t < tb) disk_at(t);
-    }
-    disk_at(tb);
+    return true;
   }
+  // Parameter interval where the plane meets the cutting part: 0 <= zc - z(t) <= H.
+  double ta = (zc - z0) / dz, tb = (zc - H - z0) / dz;
+  if (ta > tb) std::swap(ta, tb);
+  ta = std::max(ta, 0.0);
+  tb = std::min(tb, 1.0);
+  if (ta > tb) return false;
+  disk_at(ta);
+  for (const auto& st : s.stations) {
+    const double t = (zc - st.h - z0) / dz;
+    if (t > ta && t < tb) disk_at(t);
+  }
+  disk_at(tb);
+  return true;
+}
+
+std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) const {
+  const CutterShape& s = *shape_;
+  if (!section_disks(zc, sc)) return 0;
   double rmax = 0.0;
   for (const auto& d : sc.disks) rmax = std::max(rmax, d.r);
   if (rmax <= 0.0) return 0;
@@ -382,6 +392,8 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
   };
   const double T = std::tan(std::numbers::pi / n);
   sc.hull.clear();
+  sc.hull_role.clear();
+  sc.hull_grid.clear();
   for (int k = 0; k < n; ++k) {
     const double ck = uc[k].x, sk = uc[k].y;
     const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
@@ -390,9 +402,65 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
     for (int i = i0;; i += step) {
       const auto& d = disks[env[i]];
       sc.hull.push_back({d.x + d.r * ck, d.y + d.r * sk});
+      sc.hull_role.push_back(static_cast<std::uint8_t>(d.role));
+      sc.hull_grid.push_back(k);
       if (i == i1) break;
     }
   }
+}
+
+bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) const {
+  if (!vertical_ || zc < box_.lo.z || zc > box_.hi.z) return false;
+  const double dx = to_.tip.x - from_.tip.x, dy = to_.tip.y - from_.tip.y;
+  if (dx == 0.0 && dy == 0.0) return false;
+  if (!section_disks(zc, sc)) return false;
+  const auto& ds = sc.disks;
+  if (ds.front().role != 1 || ds.back().role != 2 || !(ds.front().r > 0.0) || !(ds.back().r > 0.0)) return false;
+  const double grow = 2.0 / (1.0 + std::cos(std::numbers::pi / n));
+  out.c0 = {ds.front().x, ds.front().y};
+  out.c1 = {ds.back().x, ds.back().y};
+  out.rho0 = ds.front().r * grow;
+  out.rho1 = ds.back().r * grow;
+  out.right.clear();
+  out.left.clear();
+  const bool uniform = std::all_of(ds.begin(), ds.end(), [&](const auto& d) { return d.r == ds.front().r; });
+  if (uniform) {
+    // Equal disks on one grid: the hull is the far half of each (section_vertical()), the
+    // sides are single edges between the grid vertices normal to the motion.
+    const double step = 2.0 * std::numbers::pi / n;
+    const double th = std::atan2(dy, dx);
+    auto nearest = [&](double ang) {
+      const long k = std::lround(ang / step);
+      return static_cast<int>(((k % n) + n) % n);
+    };
+    out.front_r = out.back_r = nearest(th - 0.5 * std::numbers::pi);
+    out.front_l = out.back_l = nearest(th + 0.5 * std::numbers::pi);
+    return true;
+  }
+  ramp_hull(sc, n, grow, sc.unit_circle(n));
+  // The caps are the hull's runs of start-disk and end-disk vertices; each must be one run.
+  const std::size_t m = sc.hull.size();
+  auto run_of = [&](std::uint8_t role, std::size_t& first, std::size_t& last) {
+    int starts = 0;
+    for (std::size_t i = 0; i < m; ++i)
+      if (sc.hull_role[i] == role && sc.hull_role[(i + m - 1) % m] != role) {
+        ++starts;
+        first = i;
+      }
+    if (starts != 1) return false;
+    last = first;
+    while (sc.hull_role[(last + 1) % m] == role) last = (last + 1) % m;
+    return true;
+  };
+  std::size_t s0 = 0, s1 = 0, e0 = 0, e1 = 0;
+  if (m < 3 || !run_of(1, s0, s1) || !run_of(2, e0, e1)) return false;
+  out.back_l = sc.hull_grid[s0];
+  out.back_r = sc.hull_grid[s1];
+  out.front_r = sc.hull_grid[e0];
+  out.front_l = sc.hull_grid[e1];
+  for (std::size_t i = (s1 + 1) % m; i != e0; i = (i + 1) % m) out.right.push_back(sc.hull[i]);
+  for (std::size_t i = (e1 + 1) % m; i != s0; i = (i + 1) % m) out.left.push_back(sc.hull[i]);
+  return true;
 }
 
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin) {

@@ -89,11 +89,13 @@ struct SubtractStats {
   std::uint64_t cells_reused = 0;      // cells that took the result of the level below
   std::uint64_t sections_in_air = 0;   // (cell, section) pairs left out: no material there
   std::uint64_t chain_offsets = 0;     // chain offsets built (LevelPool: some for the next batch)
+  std::uint64_t sections_joined = 0;   // move sections written as part of a joined outline
   SubtractStats& operator+=(const SubtractStats& o) noexcept {
     sections += o.sections; cells_tested += o.cells_tested;
     cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
     sections_trimmed += o.sections_trimmed; cells_reused += o.cells_reused;
     sections_in_air += o.sections_in_air; chain_offsets += o.chain_offsets;
+    sections_joined += o.sections_joined;
     return *this;
   }
 };
@@ -121,6 +123,9 @@ struct SubtractShared {
   std::vector<SweepRef> merged;   // the batch after merging collinear runs
   std::vector<Sweep> sweeps;      // one per merged milling move
   std::vector<MoveId> sweep_id;   // their move ids
+  // Runs of consecutive sweeps [first, last) of one tool with a vertical axis along a
+  // continuous path: on each level their sections are joined into outlines where they can.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
   std::vector<LatheSweep> lathe;  // one per merged turning move
   std::vector<MoveId> lathe_id;
   // Runs of at least three consecutive horizontal moves of one tool with a vertical axis at
@@ -177,6 +182,8 @@ struct SubtractWorkspace {
   ClipperLib::Clipper rect_clipper;  // cuts chain offsets to regions
   ClipperLib::PolyTree tree;
   SectionScratch scratch;
+  std::vector<MoveCaps> caps;                 // one per move of a joined run
+  std::vector<SectionScratch::P2> outline;    // a joined run's vertices before rounding
   std::vector<std::uint8_t> trim_flags;
   std::vector<int> source;          // per (level - lb, region): the level whose result it takes
   std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip
@@ -278,6 +285,8 @@ class LbrSolid {
   // Phases of subtract_shared().
   void build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& out,
                    SubtractStats& stats) const;
+  void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
+                          SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   const Paths& offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const;
   bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                  SubtractStats& stats);

@@ -40,7 +40,11 @@ struct SectionScratch {
   struct Disk {
     double x, y, r;
     double s = 0.0;  // position of the centre along the horizontal motion [mm]
+    int role = 0;    // 1: the start pose's disk (t = 0), 2: the end pose's disk (t = 1), 0: other
   };
+  // Set by ramp_hull(): per hull vertex, the role of its disk and its index on the angle grid.
+  std::vector<std::uint8_t> hull_role;
+  std::vector<int> hull_grid;
   std::vector<Disk> disks;
   std::vector<int> env;        // upper envelope of the disks' support lines (indices)
   std::vector<double> breaks;  // where env[i] takes over from env[i-1]
@@ -67,6 +71,20 @@ struct SectionScratch {
 // a ∪ b' = a ∪ b: when a's polygon is removed from the stock in the same operation, b' does
 // the same work with fewer edges. Returns false when every vertex of b lies inside a (b is
 // then unchanged and can be dropped). `flags` is a reusable buffer.
+// The section of one vertical move on one plane, split for joining consecutive moves into
+// one outline (geom/src/chain_outline.cpp). All vertices lie on one angle grid of n
+// directions: the start disk J0 (centre c0, circumradius rho0) and the end disk J1 carry
+// the caps; the back cap runs counter-clockwise over J0's grid vertices [back_l, back_r],
+// the front cap over J1's [front_r, front_l]; `right` holds the hull vertices strictly
+// between the back cap's last and the front cap's first vertex, `left` those between the
+// front cap's last and the back cap's first (both counter-clockwise) [mm].
+struct MoveCaps {
+  SectionScratch::P2 c0{}, c1{};
+  double rho0 = 0.0, rho1 = 0.0;
+  int back_l = 0, back_r = 0, front_r = 0, front_l = 0;
+  std::vector<SectionScratch::P2> right, left;
+};
+
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
 
 class Sweep {
@@ -81,6 +99,7 @@ class Sweep {
   [[nodiscard]] const Box3& bounds() const noexcept { return box_; }
   // True when both poses have the axis exactly +Z (the 3-axis fast path).
   [[nodiscard]] bool vertical() const noexcept { return vertical_; }
+  [[nodiscard]] const CutterShape& shape() const noexcept { return *shape_; }
 
   // Appends the section on plane z = z_mm as convex polygons (counter-clockwise, kernel
   // units) to out; returns how many were appended. `scratch` is reused between calls to
@@ -91,12 +110,21 @@ class Sweep {
   // tolerance (at least 8, at most 4096).
   [[nodiscard]] static int circle_segments(double r_mm, double chord_tol_mm) noexcept;
 
+  // Vertical sweeps only: the section on z = z_mm on the grid of n directions, split into
+  // caps and sides (MoveCaps). False when the section has no start or no end disk on its
+  // boundary (the plane misses the cutting part at either pose, the disk there has no
+  // radius, or the move does not move in XY); `out` is then unspecified. Real-time safe once
+  // the buffers have grown.
+  bool section_caps(double z_mm, int n, SectionScratch& scratch, MoveCaps& out) const;
+
   static constexpr int kMaxSubsteps = 256;
 
  private:
   std::size_t section_vertical(double z_mm, Paths& out, SectionScratch& scratch) const;
   std::size_t section_general(double z_mm, Paths& out, SectionScratch& scratch) const;
   void ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<SectionScratch::P2>& uc) const;
+  // The disks whose hull is the section on z = zc (vertical sweeps); false when none.
+  bool section_disks(double zc, SectionScratch& sc) const;
 
   const CutterShape* shape_;
   Pose from_, to_;
