@@ -122,7 +122,7 @@ std::vector<TriKey> canonical(const mesh::Reconstructor& rec) {
       TriKey k;
       for (int v = 0; v < 3; ++v) {
         const std::uint32_t i = m.indices[3 * t + v];
-        k[v] = {m.keys[i].x, m.keys[i].y, m.keys[i].plane, m.positions[3 * i + 2]};
+        k[v] = {m.keys[i].x, m.keys[i].y, m.keys[i].height, m.positions[3 * i + 2]};
       }
       std::rotate(k.begin(), std::min_element(k.begin(), k.end()), k.end());
       out.push_back(k);

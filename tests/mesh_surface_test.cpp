@@ -62,10 +62,10 @@ Quality measure(const geom::LbrSolid& s, const std::vector<Pass>& passes, mesh::
     const mesh::MeshBuffers& m = rec.region(r);
     for (std::size_t v = 0; v < m.vertex_count(); ++v) {
       const mesh::VertexKey& k = m.keys[v];
-      if (k.plane == 0 || std::find(border_y.begin(), border_y.end(), k.y) != border_y.end()) continue;
+      if (k.height == 0 || std::find(border_y.begin(), border_y.end(), k.y) != border_y.end()) continue;
       const double d = distance(passes, s.z_top_mm(), geom::to_mm(k.y), static_cast<double>(m.positions[3 * v + 2]));
       if (d > q.max_mm && std::getenv("LBR_MESH_DEBUG"))
-        std::printf("max at x %.4f y %.4f z %.4f plane %d: %.4f\n", geom::to_mm(k.x), geom::to_mm(k.y), m.positions[3 * v + 2], k.plane, d);
+        std::printf("max at x %.4f y %.4f z %.4f height %d: %.4f\n", geom::to_mm(k.x), geom::to_mm(k.y), m.positions[3 * v + 2], k.height, d);
       q.max_mm = std::max(q.max_mm, d);
       q.mean_mm += d;
       ++n;

@@ -57,7 +57,7 @@ inline EdgeCensus census(const std::vector<const MeshBuffers*>& regions) {
       K k[3];
       for (int v = 0; v < 3; ++v) {
         const VertexKey& q = m->keys[m->indices[3 * t + v]];
-        k[v] = {q.x, q.y, q.plane};
+        k[v] = {q.x, q.y, q.height};
       }
       if (k[0] == k[1] || k[1] == k[2] || k[0] == k[2]) {
         ++c.degenerate;

@@ -81,6 +81,7 @@ enum : std::uint8_t {
 
 struct VInfo {
   double z = 0;
+  std::int32_t height = 0;  // VertexKey::height: 2k at plane k, 2l+1 when moved to level l's mid-plane
   MoveId attr = 0;
   std::uint8_t flags = 0;
 };
@@ -99,6 +100,7 @@ struct Tri {
   std::array<Point, 3> p;
   std::array<std::int32_t, 3> plane;
   std::array<double, 3> z{};
+  std::array<std::int32_t, 3> height{};
   std::array<MoveId, 3> attr{};
 };
 
@@ -395,7 +397,7 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
         const MoveId id = cs[sd][c]->cut_by;
         for (std::uint32_t i = 0; i < nd.pts.size(); ++i) {
           const Point& x = nd.pts[i];
-          auto it = pd.verts.try_emplace(x, VInfo{zk, 0, 0}).first;
+          auto it = pd.verts.try_emplace(x, VInfo{zk, 2 * k, 0, 0}).first;
           it->second.flags |= (sd == 0 ? kLower : kUpper);
           if (is_orig[sd][c][i]) it->second.flags |= (sd == 0 ? kLowerOrig : kUpperOrig);
           if (on_shared_border(x)) it->second.flags |= kPinned;
@@ -450,7 +452,7 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
         for (const Point& x : out)
           if (!pd.verts.count(x)) {
             extra.push_back(x);  // made by Clipper: fed back into the noding below
-            pd.verts.emplace(x, VInfo{zk, 0, kPinned});
+            pd.verts.emplace(x, VInfo{zk, 2 * k, 0, kPinned});
           }
       };
 
@@ -515,6 +517,10 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
     // keeps that edge's wall in its vertical plane) moves to its level's mid-plane when its
     // step is narrow and the wall continuing it beyond that level is not vertical (the
     // level two away has no vertex there): sharp flat-end steps and flat floors stay.
+    auto to_mid = [&](VInfo& v, int level) {
+      v.z = s.level_z_mm(level);
+      v.height = 2 * level + 1;
+    };
     std::unordered_set<Point, PointHash, PointEq> below2, above1;
     auto fill = [&](int lev, std::unordered_set<Point, PointHash, PointEq>& out) {
       if (lev < 0 || lev >= levels) return;
@@ -528,8 +534,8 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
     for (auto& [x, v] : pd.verts) {
       if ((v.flags & kPinned) || !(v.flags & kNarrow) || (v.flags & kWide)) continue;
       const std::uint8_t o = v.flags & (kLowerOrig | kUpperOrig);
-      if (o == kLowerOrig && !below2.count(x)) v.z = s.level_z_mm(k - 1);
-      else if (o == kUpperOrig && !above1.count(x)) v.z = s.level_z_mm(k);
+      if (o == kLowerOrig && !below2.count(x)) to_mid(v, k - 1);
+      else if (o == kUpperOrig && !above1.count(x)) to_mid(v, k);
     }
     // Border rule: on a shared border line, the union of both regions' levels k-1 and k is
     // seen as intervals; a vertex where only the level-(k-1) material ends moves to that
@@ -593,8 +599,8 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
         if (corner) continue;
         const Coord c = line_coord(sd, x);
         const bool lo = has(lo_end, c), up = has(up_end, c);
-        if (lo && !up && !has(lo2_end, c) && near_other(c)) v.z = s.level_z_mm(k - 1);
-        else if (up && !lo && !has(up1_end, c) && near_other(c)) v.z = s.level_z_mm(k);
+        if (lo && !up && !has(lo2_end, c) && near_other(c)) to_mid(v, k - 1);
+        else if (up && !lo && !has(up1_end, c) && near_other(c)) to_mid(v, k);
       }
     }
   }
@@ -602,6 +608,7 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
     for (int v = 0; v < 3; ++v) {
       const auto it = pd.verts.find(t.p[v]);
       t.z[v] = it != pd.verts.end() ? it->second.z : zk;
+      t.height[v] = it != pd.verts.end() ? it->second.height : 2 * k;
       t.attr[v] = it != pd.verts.end() ? it->second.attr : 0;
     }
 }
@@ -652,6 +659,7 @@ void Reconstructor::Cache::build_wall(const geom::LbrSolid& s, int r, int l) {
       const PlaneData& pd = regions[r].planes[t.plane[v]];
       const auto it = pd.verts.find(t.p[v]);
       t.z[v] = it != pd.verts.end() ? it->second.z : plane_z(s, t.plane[v]);
+      t.height[v] = it != pd.verts.end() ? it->second.height : 2 * t.plane[v];
       t.attr[v] = it != pd.verts.end() ? it->second.attr : 0;
     }
     return t;
@@ -750,7 +758,7 @@ void Reconstructor::Cache::assemble(const geom::LbrSolid& s, int r) {
   };
   struct AHash {
     std::size_t operator()(const AKey& a) const noexcept {
-      return PointHash{}(Point{a.k.x, a.k.y}) ^ (static_cast<std::size_t>(a.k.plane) * 0x51ED27u) ^
+      return PointHash{}(Point{a.k.x, a.k.y}) ^ (static_cast<std::size_t>(a.k.height) * 0x51ED27u) ^
              static_cast<std::size_t>(a.cls);
     }
   };
@@ -762,6 +770,15 @@ void Reconstructor::Cache::assemble(const geom::LbrSolid& s, int r) {
   const double ox = geom::to_mm(s.stock_rect().x0), oy = geom::to_mm(s.stock_rect().y0), oz = s.z_bottom_mm();
 
   auto add_tri = [&](const Tri& t) {
+    // Vertices are identified by position (x, y, height), not by the plane they came from:
+    // a joined wall whose two ends moved to the same mid-plane has collapsed, its two vertex
+    // columns are one vertex and its triangles have no area. Dropping them keeps every edge
+    // paired (each directed edge of a dropped triangle is a loop or cancels against its
+    // reverse in the same triangle), so the surface stays closed without zero-area facets.
+    const std::array<VertexKey, 3> key{VertexKey{t.p[0].X, t.p[0].Y, t.height[0]},
+                                       VertexKey{t.p[1].X, t.p[1].Y, t.height[1]},
+                                       VertexKey{t.p[2].X, t.p[2].Y, t.height[2]}};
+    if (key[0] == key[1] || key[1] == key[2] || key[0] == key[2]) return;
     std::array<std::array<double, 3>, 3> q{};
     std::array<MoveId, 3> attr{};
     for (int v = 0; v < 3; ++v) {
@@ -783,10 +800,10 @@ void Reconstructor::Cache::assemble(const geom::LbrSolid& s, int r) {
     const bool flat = q[0][2] == q[1][2] && q[1][2] == q[2][2] && n[2] != 0.0;
     const int cls = flat ? (n[2] > 0 ? 1 : 2) : 0;
     for (int v = 0; v < 3; ++v) {
-      const AKey key{{t.p[v].X, t.p[v].Y, t.plane[v]}, cls};
-      auto [it, fresh] = index.try_emplace(key, static_cast<std::uint32_t>(out.keys.size()));
+      const AKey ak{key[v], cls};
+      auto [it, fresh] = index.try_emplace(ak, static_cast<std::uint32_t>(out.keys.size()));
       if (fresh) {
-        out.keys.push_back(key.k);
+        out.keys.push_back(ak.k);
         for (int a = 0; a < 3; ++a) pos.push_back(q[v][a]);
         nrm.insert(nrm.end(), {0.0, 0.0, cls == 1 ? 1.0 : (cls == 2 ? -1.0 : 0.0)});
         out.attributes.push_back(static_cast<float>(attr[v]));

@@ -33,10 +33,12 @@ struct MeshOptions {
   double join_width_levels = 20.0;
 };
 
-// Exact identity of a mesh vertex: plane k is z = bottom of level k (k = levels(): top).
+// Exact identity of a mesh vertex, by position. Height index: 2k = plane k (z = bottom of
+// level k; k = levels(): top), 2l+1 = mid-plane of level l (joined walls move vertices
+// there). Two vertices with the same key are one vertex, also across regions.
 struct VertexKey {
   geom::Coord x = 0, y = 0;  // [units]
-  std::int32_t plane = 0;
+  std::int32_t height = 0;
   friend bool operator==(const VertexKey&, const VertexKey&) = default;
 };
 
