@@ -131,3 +131,17 @@ TEST(Batch, WorkerThreadsGiveTheSameSolid) {
     EXPECT_EQ(one.solid.dirty_cells(), many.solid.dirty_cells());
   }
 }
+
+// [nc] keys reach the G-code front ends (issue 14): start tool, subroutine folders relative
+// to the profile's folder, and an error naming file, line and key.
+TEST(Profile, NcSectionReachesTheInterpreterOptions) {
+  const app::Profile p =
+      app::parse_profile(std::string(kStock) + "\n[nc]\nstart_tool = 2\nsubroutine_path = [\"subs\", \"/abs/lib\"]\n",
+                         "/cfg/m.toml");
+  const nc::GcodeOptions o = app::gcode_options(p);
+  EXPECT_EQ(o.start_tool, 2);
+  ASSERT_EQ(o.subroutine_path.size(), 2u);
+  EXPECT_EQ(o.subroutine_path[0], "/cfg/subs");
+  EXPECT_EQ(o.subroutine_path[1], "/abs/lib");
+  EXPECT_NE(error_of(std::string(kStock) + "\n[nc]\nstart_tol = 1\n").find("nc.start_tol: unknown key"), std::string::npos);
+}

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -480,6 +481,22 @@ Profile parse_profile(const std::string& text, const std::string& name) {
       p.channels.push_back(std::move(c));
     }
   }
+  if (const toml::table* nt = top.table("nc")) {  // G-code front ends
+    Section s(*nt, "nc", name);
+    p.start_tool = static_cast<int>(s.integer("start_tool", 0, 0, 99999));
+    if (const toml::node* n = s.get("subroutine_path")) {
+      const toml::array* a = n->as_array();
+      if (a == nullptr) s.fail(n, "subroutine_path", "expected an array of folder names");
+      const std::filesystem::path base = std::filesystem::path(name).parent_path();
+      for (const toml::node& e : *a) {
+        const auto v = e.value_exact<std::string>();
+        if (!v) s.fail(&e, "subroutine_path", "expected folder names (strings)");
+        const std::filesystem::path d(*v);
+        p.subroutine_path.push_back(d.is_relative() && !base.empty() ? (base / d).string() : d.string());
+      }
+    }
+    s.reject_unknown();
+  }
   read_live(top, p, name);
   if (const toml::table* rt = top.table("render")) {
     Section s(*rt, "render", name);
@@ -532,6 +549,13 @@ nc::GcodeOptions gcode_options(const Profile& p) {
     o.tool_lengths[n] = lathe ? 0.0 : t.length_mm;
     o.tool_diameters[n] = t.diameter_mm;
   }
+  for (const auto& [n, insert] : p.inserts) o.tool_lengths.emplace(n, 0.0);  // rs274's tool table lists them too
+  if (p.kin.kind == kin::MachineKind::Mill5) {
+    const bool ac = p.kin.rotary == kin::Rotary::TableAC || p.kin.rotary == kin::Rotary::HeadAC;
+    o.rotary = {ac, !ac, true};
+  }
+  o.subroutine_path = p.subroutine_path;
+  o.start_tool = p.start_tool;
   o.chord_tol_mm = p.solid.chord_tol_mm;
   for (int a = 0; a < 3; ++a) o.work_offsets[0][a] = p.g54_origin_mm[static_cast<std::size_t>(a)];
   return o;

@@ -57,6 +57,9 @@ struct Profile {
   std::map<int, geom::TurningTool> inserts;    // turning tools (lathe kinds), same numbering
   std::map<int, kin::Mount> live_mounts;       // lathe-c: how each milling tool is mounted
   std::vector<Channel> channels;               // empty: one channel, the program given
+  // [nc]: G-code front ends (docs/profiles.md, docs/nc-frontend.md).
+  std::vector<std::string> subroutine_path;    // searched for NAME.ngc after the program's folder
+  int start_tool = 0;                          // tool in the spindle at program start (0: none)
   // Mount of tool n on this machine (Spindle on mills).
   [[nodiscard]] kin::Mount mount_of(int tool) const;
 };
