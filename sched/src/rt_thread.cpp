@@ -75,41 +75,4 @@ RtMode configure_current_thread(const RtConfig& cfg) noexcept {
   return RtMode::NonRt;
 }
 
-void PeriodicThread::start(const RtConfig& cfg, std::int64_t period_ns, std::function<bool()> tick) {
-  stop();
-  stop_.store(false);
-  running_.store(true, std::memory_order_release);
-  thread_ = std::thread([this, cfg, period_ns, tick = std::move(tick)] {
-    mode_.store(configure_current_thread(cfg), std::memory_order_release);
-    std::int64_t next = now_ns() + period_ns;
-    while (!stop_.load(std::memory_order_acquire)) {
-      sleep_until_ns(next);
-      const std::int64_t woke = now_ns();
-      stats_.wake_latency.record(woke - next);
-      const bool more = tick();
-      const std::int64_t done = now_ns();
-      stats_.run_time.record(done - woke);
-      stats_.ticks.store(stats_.ticks.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-      next += period_ns;
-      if (done > next) {
-        const std::int64_t lost = (done - next) / period_ns + 1;
-        stats_.missed.store(stats_.missed.load(std::memory_order_relaxed) + static_cast<std::uint64_t>(lost),
-                            std::memory_order_relaxed);
-        next += lost * period_ns;
-      }
-      if (!more) break;
-    }
-    running_.store(false, std::memory_order_release);
-  });
-}
-
-void PeriodicThread::stop() {
-  stop_.store(true, std::memory_order_release);
-  join();
-}
-
-void PeriodicThread::join() {
-  if (thread_.joinable()) thread_.join();
-}
-
 }  // namespace lbr::sched

@@ -47,7 +47,6 @@ struct LiveStats {
   std::uint64_t samples = 0;
   std::uint64_t ring_high_water = 0, ring_capacity = 0, ring_overruns = 0;
   std::uint64_t decode_errors = 0;
-  std::uint64_t deadline_misses = 0;
   bool realtime = false;         // SCHED_FIFO granted to the HAL/geometry threads
   bool live = false;             // false: batch result or replay without live counters
 };

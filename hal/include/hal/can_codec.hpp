@@ -48,9 +48,6 @@ class CanopenAssembler {
   [[nodiscard]] std::uint64_t lost() const noexcept { return lost_; }
 
  private:
-  struct Slot {
-    int map = -1;  // index into maps_
-  };
   void close_cycle(Counters& c) noexcept;
 
   LiveConfig cfg_;

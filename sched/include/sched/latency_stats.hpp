@@ -43,12 +43,4 @@ class LatencyHistogram {
   std::atomic<std::int64_t> max_{0}, min_{0}, sum_{0};
 };
 
-// Deadline statistics of a periodic activity.
-struct DeadlineStats {
-  LatencyHistogram wake_latency;  // actual wake-up − scheduled wake-up [ns]
-  LatencyHistogram run_time;      // duration of one tick [ns]
-  std::atomic<std::uint64_t> ticks{0};
-  std::atomic<std::uint64_t> missed{0};  // ticks that ended after the next period began
-};
-
 }  // namespace lbr::sched
