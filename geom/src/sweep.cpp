@@ -196,7 +196,7 @@ Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcep
     const double reach = std::hypot(H, R);
     const double c = 1.0 - std::min(1.0, shape.chord_tol_mm / reach);
     const double step = 2.0 * std::acos(c);
-    substeps_ = std::clamp(static_cast<int>(std::ceil(ang / step)), 1, kMaxSubsteps);
+    substeps_ = std::clamp(static_cast<int>(std::ceil(ang / step)), 1, kMaxTiltSubsteps);
   }
   for (int k = 0; k <= substeps_; ++k) {
     const double t = static_cast<double>(k) / substeps_;

@@ -117,7 +117,7 @@ class Sweep {
   // the buffers have grown.
   bool section_caps(double z_mm, int n, SectionScratch& scratch, MoveCaps& out) const;
 
-  static constexpr int kMaxSubsteps = 256;
+  static constexpr int kMaxTiltSubsteps = 256;  // sub-steps of one sweep whose tool axis turns (kin::kMaxMoveSubsteps: pieces of a move)
 
  private:
   std::size_t section_vertical(double z_mm, Paths& out, SectionScratch& scratch) const;
