@@ -249,92 +249,89 @@ struct RunOptions {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 
-int run_live_command(const RunOptions& o) {
-  const app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+void install_stop_handlers() {
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
-  spdlog::info("run: source {}, profile {}, period {} ms", o.live.source, profile.source, profile.live.period_ms);
-  app::StatusFn status;
-  if (!o.quiet) status = [](const std::string& line) { spdlog::info("{}", line); };
+}
 
-  // Rendering: a window (visible, or hidden for screenshots only) when a display exists.
-  const bool want_render = o.screenshot_every > 0 || (!o.no_window && gfx::display_available());
-  if (o.screenshot_every > 0 && !gfx::display_available())
-    throw gfx::DisplayError("--screenshot-every needs an X or Wayland display for its hidden OpenGL window, and "
-                            "neither DISPLAY nor WAYLAND_DISPLAY is set. Run it under a virtual X server: "
-                            "`xvfb-run -a lbrsim run ...`");
+gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profile& profile) {
+  gfx::RenderThreadConfig rc;
+  rc.rate_hz = o.rate_hz > 0 ? o.rate_hz : profile.render_rate_hz;
+  rc.view = gfx::parse_view(o.view);
+  rc.ortho = rc.view == gfx::StandardView::Top;
+  rc.render.color = gfx::parse_color_mode(o.color);
+  gfx::parse_size(o.size, rc.width, rc.height);
+  rc.screenshot_every = o.screenshot_every;
+  rc.screenshot_prefix = o.screenshot_prefix;
+  return rc;
+}
+
+void log_render_report(const gfx::PacingReport& rep, double rate_hz) {
+  if (!rep.error.empty()) spdlog::warn("render thread stopped: {}", rep.error);
+  using P = gfx::PacingReport;
+  const std::vector<double> rebuilt(rep.regions_rebuilt.begin(), rep.regions_rebuilt.end());
+  double rebuilt_sum = 0;
+  for (double v : rebuilt) rebuilt_sum += v;
+  spdlog::info("render: {} frames ({} late) at {} Hz | period p50 {:.2f} p99 {:.2f} max {:.2f} ms | work p50 {:.2f} "
+               "p99 {:.2f} ms | mesh p99 {:.2f} ms | regions rebuilt per frame mean {:.2f} max {:.0f} | {} "
+               "screenshots | {}",
+               rep.frames, rep.late_frames, rate_hz, P::percentile(rep.period_ms, 0.5), P::percentile(rep.period_ms, 0.99),
+               P::percentile(rep.period_ms, 1.0), P::percentile(rep.work_ms, 0.5), P::percentile(rep.work_ms, 0.99),
+               P::percentile(rep.mesh_ms, 0.99), rep.frames ? rebuilt_sum / static_cast<double>(rep.frames) : 0.0,
+               P::percentile(rebuilt, 1.0), rep.screenshots, rep.gl);
+}
+
+// The live run on its own thread while the main thread owns the window's events and the
+// render thread draws what the geometry thread publishes.
+app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profile, const app::StatusFn& status) {
+  const gfx::RenderThreadConfig rc = live_render_config(o, profile);
+  const bool visible = !o.hidden && !o.no_window;
+  gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source);
+  gfx::SolidExchange ex(1 << 14);
+  std::promise<std::unique_ptr<geom::LbrSolid>> initial;
+  auto initial_ready = initial.get_future();
+  app::LiveOptions lo = o.live;
+  lo.exchange = &ex;
+  lo.on_start = [&initial](const geom::LbrSolid& s) { initial.set_value(std::make_unique<geom::LbrSolid>(s)); };
   std::optional<app::LiveResult> result;
-  if (!want_render) {
-    result.emplace(app::run_live(profile, o.live, g_stop, status));
-  } else {
-    gfx::RenderThreadConfig rc;
-    rc.rate_hz = o.rate_hz > 0 ? o.rate_hz : profile.render_rate_hz;
-    rc.view = gfx::parse_view(o.view);
-    rc.ortho = rc.view == gfx::StandardView::Top;
-    rc.render.color = gfx::parse_color_mode(o.color);
-    gfx::parse_size(o.size, rc.width, rc.height);
-    rc.screenshot_every = o.screenshot_every;
-    rc.screenshot_prefix = o.screenshot_prefix;
-    const bool visible = !o.hidden && !o.no_window;
-    gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source);
-    gfx::SolidExchange ex(1 << 14);
-    // The live run goes on its own thread; the main thread owns the window's events.
-    std::promise<std::unique_ptr<geom::LbrSolid>> initial;
-    auto initial_ready = initial.get_future();
-    app::LiveOptions lo = o.live;
-    lo.exchange = &ex;
-    lo.on_start = [&initial](const geom::LbrSolid& s) { initial.set_value(std::make_unique<geom::LbrSolid>(s)); };
-    std::exception_ptr live_error;
-    std::atomic<bool> live_done{false};
-    std::thread live([&] {
+  std::exception_ptr live_error;
+  std::atomic<bool> live_done{false};
+  std::thread live([&] {
+    try {
+      result.emplace(app::run_live(profile, lo, g_stop, status));
+    } catch (...) {
+      live_error = std::current_exception();
       try {
-        result.emplace(app::run_live(profile, lo, g_stop, status));
-      } catch (...) {
-        live_error = std::current_exception();
-        try {
-          initial.set_value(nullptr);
-        } catch (...) {  // already set
-        }
+        initial.set_value(nullptr);
+      } catch (...) {  // already set
       }
-      live_done.store(true);
-    });
-    std::unique_ptr<geom::LbrSolid> start = initial_ready.get();
-    if (start) {
-      gfx::RenderThread rt(win, ex, *start, rc);
-      start.reset();
-      rt.start();
-      if (visible) {
-        gfx::run_event_loop(win, rt, [&] { return !live_done.load(); });
-      } else {
-        while (!live_done.load() && rt.running()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      }
-      // Show the final state for one more frame period before closing.
-      std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(2000.0 / rc.rate_hz)));
-      rt.stop();
-      const gfx::PacingReport& rep = rt.report();
-      if (!rep.error.empty()) spdlog::warn("render thread stopped: {}", rep.error);
-      using P = gfx::PacingReport;
-      const std::vector<double> rebuilt(rep.regions_rebuilt.begin(), rep.regions_rebuilt.end());
-      double rebuilt_sum = 0;
-      for (double v : rebuilt) rebuilt_sum += v;
-      spdlog::info("render: {} frames ({} late) at {} Hz | period p50 {:.2f} p99 {:.2f} max {:.2f} ms | work p50 {:.2f} "
-                   "p99 {:.2f} ms | mesh p99 {:.2f} ms | regions rebuilt per frame mean {:.2f} max {:.0f} | {} "
-                   "screenshots | {}",
-                   rep.frames, rep.late_frames, rc.rate_hz, P::percentile(rep.period_ms, 0.5),
-                   P::percentile(rep.period_ms, 0.99), P::percentile(rep.period_ms, 1.0), P::percentile(rep.work_ms, 0.5),
-                   P::percentile(rep.work_ms, 0.99), P::percentile(rep.mesh_ms, 0.99),
-                   rep.frames ? rebuilt_sum / static_cast<double>(rep.frames) : 0.0, P::percentile(rebuilt, 1.0),
-                   rep.screenshots, rep.gl);
     }
-    live.join();
-    if (live_error) std::rethrow_exception(live_error);
+    live_done.store(true);
+  });
+  std::unique_ptr<geom::LbrSolid> start = initial_ready.get();
+  if (start) {
+    gfx::RenderThread rt(win, ex, *start, rc);
+    start.reset();
+    rt.start();
+    if (visible) {
+      gfx::run_event_loop(win, rt, [&] { return !live_done.load(); });
+    } else {
+      while (!live_done.load() && rt.running()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    // Show the final state for one more frame period before closing.
+    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(2000.0 / rc.rate_hz)));
+    rt.stop();
+    log_render_report(rt.report(), rc.rate_hz);
   }
-  const app::LiveResult& r = *result;
-  app::write_live_outputs(o.out, r, profile);
-  app::write_mesh_files(r.solid, o.stl, o.ply);
+  live.join();
+  if (live_error) std::rethrow_exception(live_error);
+  return std::move(*result);
+}
+
+void print_live_summary(const RunOptions& o, const app::LiveResult& r) {
   std::uint64_t errors = 0;
   for (const auto& [k, v] : r.decode_errors) errors += v;
   std::printf("%s | received %llu applied %llu lost %llu | ring overruns %llu high water %llu | decode errors %llu | "
@@ -346,20 +343,39 @@ int run_live_command(const RunOptions& o) {
               r.rt_mode.c_str(), g_stop.load() ? " | stopped by signal" : "");
   std::printf("wrote %s/metrics.json and %s/levels.lbrs%s%s%s%s\n", o.out.c_str(), o.out.c_str(),
               o.stl.empty() ? "" : ", ", o.stl.c_str(), o.ply.empty() ? "" : ", ", o.ply.c_str());
+}
+
+int run_live_command(const RunOptions& o) {
+  const app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+  install_stop_handlers();
+  spdlog::info("run: source {}, profile {}, period {} ms", o.live.source, profile.source, profile.live.period_ms);
+  app::StatusFn status;
+  if (!o.quiet) status = [](const std::string& line) { spdlog::info("{}", line); };
+  // Rendering: a window (visible, or hidden for screenshots only) when a display exists.
+  const bool want_render = o.screenshot_every > 0 || (!o.no_window && gfx::display_available());
+  if (o.screenshot_every > 0 && !gfx::display_available())
+    throw gfx::DisplayError("--screenshot-every needs an X or Wayland display for its hidden OpenGL window, and "
+                            "neither DISPLAY nor WAYLAND_DISPLAY is set. Run it under a virtual X server: "
+                            "`xvfb-run -a lbrsim run ...`");
+  const app::LiveResult r =
+      want_render ? run_live_rendered(o, profile, status) : app::run_live(profile, o.live, g_stop, status);
+  app::write_live_outputs(o.out, r, profile);
+  app::write_mesh_files(r.solid, o.stl, o.ply);
+  print_live_summary(o, r);
   return 0;
 }
 
-}  // namespace
+void add_render_options(CLI::App* c, BatchOptions& o) {
+  c->add_option("--view", o.view, "Camera: top, front, side or iso")
+      ->check(CLI::IsMember({"top", "front", "side", "iso"}))
+      ->capture_default_str();
+  c->add_option("--color", o.color, "Colour mode: plain, heat (move of the last cut) or regions (grid)")
+      ->check(CLI::IsMember({"plain", "heat", "regions"}))
+      ->capture_default_str();
+  c->add_option("--size", o.size, "Image / window size WxH [px]")->capture_default_str();
+}
 
-int main(int argc, char** argv) {
-  CLI::App cli{"lbrsim " LBRSIM_VERSION " — NC machining simulator on a level-based representation (LBR)"};
-  cli.set_version_flag("--version", std::string("lbrsim ") + LBRSIM_VERSION);
-  cli.require_subcommand(1);
-  std::string log_level = "info";
-  cli.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
-
-  BatchOptions b;
+CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
   CLI::App* batch = cli.add_subcommand("batch", "Run a part program through the simulator as fast as possible");
   batch->add_option("--program", b.program,
                     "Part program: a move list (.moves) or G-code (.ngc, .nc, .gcode, .tap); without it the "
@@ -387,21 +403,13 @@ int main(int argc, char** argv) {
   batch->add_option("--stl", b.stl, "Also write the reconstructed part as binary STL to this file");
   batch->add_option("--ply", b.ply, "Also write the reconstructed part as binary PLY (with normals, move id) to this file");
 
-  auto add_render_options = [](CLI::App* c, BatchOptions& o) {
-    c->add_option("--view", o.view, "Camera: top, front, side or iso")
-        ->check(CLI::IsMember({"top", "front", "side", "iso"}))
-        ->capture_default_str();
-    c->add_option("--color", o.color, "Colour mode: plain, heat (move of the last cut) or regions (grid)")
-        ->check(CLI::IsMember({"plain", "heat", "regions"}))
-        ->capture_default_str();
-    c->add_option("--size", o.size, "Image / window size WxH [px]")->capture_default_str();
-  };
   batch->add_option("--png", b.png, "Render the result offscreen to this PNG (needs a display; headless: xvfb-run -a)");
   add_render_options(batch, b);
   batch->add_flag("--view-window", b.view_window, "Then open the interactive viewer on the program (runs it again)");
+  return batch;
+}
 
-  BatchOptions vb;
-  ViewCliOptions vv;
+CLI::App* add_view_command(CLI::App& cli, BatchOptions& vb, ViewCliOptions& vv) {
   CLI::App* view = cli.add_subcommand("view", "Interactive viewer: a batch result, or the program streamed in real time");
   view->add_option("--program", vb.program, "Part program (.moves or G-code); default: the bundled demo");
   view->add_option("--interpreter", vb.interpreter, "G-code front end: builtin or rs274")
@@ -424,8 +432,10 @@ int main(int argc, char** argv) {
   view->add_option("--screenshot-every", vv.screenshot_every, "Write a PNG every N frames")->check(CLI::Range(0, 1000000));
   view->add_option("--screenshot-prefix", vv.screenshot_prefix, "Screenshot file prefix (PREFIX000123.png)")
       ->capture_default_str();
+  return view;
+}
 
-  RunOptions ro;
+CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   CLI::App* run = cli.add_subcommand("run", "Simulate live from a machine (CAN, serial), a log replay or the emulator");
   ro.live.source = "emulator:demo";
   run->add_option("--source", ro.live.source,
@@ -455,9 +465,10 @@ int main(int argc, char** argv) {
   run->add_option("--size", ro.size, "Window / screenshot size WxH [px]")->capture_default_str();
   run->add_option("--render-rate", ro.rate_hz, "Render rate [Hz] (default: the profile's [render] rate_hz, 30)")
       ->check(CLI::Range(1.0, 240.0));
+  return run;
+}
 
-
-  EmulateOptions em;
+CLI::App* add_emulate_command(CLI::App& cli, EmulateOptions& em) {
   CLI::App* emu = cli.add_subcommand("emulate", "Run a part program through the machine emulator and write its samples");
   emu->add_option("program", em.program, "Part program (G-code or .moves)")->required();
   emu->add_option("--profile", em.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
@@ -466,70 +477,106 @@ int main(int argc, char** argv) {
   emu->add_option("--interpreter", em.interpreter, "G-code front end: builtin or rs274")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  return emu;
+}
 
-  struct TuneOptions {
-    std::string program, profile, write;
-    int repeats = 1;
-  } to;
+struct TuneOptions {
+  std::string program, profile, write;
+  int repeats = 1;
+};
+
+CLI::App* add_tune_command(CLI::App& cli, TuneOptions& to) {
   CLI::App* tune = cli.add_subcommand(
       "tune", "Measure the kernel on a program's sampled stream for several region grids and pick the fastest");
   tune->add_option("--program", to.program, "Part program (.ngc, .nc, .gcode, .tap or .moves)")->required();
   tune->add_option("--profile", to.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
   tune->add_option("--write", to.write, "Write the profile with the fastest grid as lbr.regions to this file");
   tune->add_option("--repeats", to.repeats, "Runs per grid (the best counts)")->check(CLI::Range(1, 20))->capture_default_str();
+  return tune;
+}
 
+int run_tune_command(const TuneOptions& o) {
+  const app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+  const nc::Toolpath path = app::load_toolpath(o.program, profile);
+  const nc::Toolpath sampled = nc::sampled_toolpath(path, app::emulator_limits(profile));
+  const double machining = nc::emulated_time_s(path, app::emulator_limits(profile));
+  double dmax = 1.0;
+  for (const auto& [n, t] : profile.tools) dmax = std::max(dmax, t.diameter_mm);
+  const auto grids = app::tune_candidates(profile, dmax);
+  std::printf("tune: %s, %zu samples, %zu grids, one kernel thread\n", o.program.c_str(), sampled.segments.size(),
+              grids.size());
+  const auto t = app::tune_regions(profile, sampled, grids, o.repeats, [&](const app::GridTiming& g) {
+    std::printf("  %2dx%-2d  %8.3f s  factor %.5f\n", g.nx, g.ny, g.wall_s, machining > 0 ? g.wall_s / machining : 0.0);
+    std::fflush(stdout);
+  });
+  std::printf("fastest: regions = \"%dx%d\" (%.3f s)\n", t.front().nx, t.front().ny, t.front().wall_s);
+  if (!o.write.empty()) {
+    const std::string base = o.profile.empty() ? std::string(app::default_profile_text())
+                                                : nc::read_text_file(o.profile);
+    app::write_file(o.write, app::set_regions_in_profile_text(base, t.front().nx, t.front().ny));
+    std::printf("wrote %s\n", o.write.c_str());
+  }
+  return 0;
+}
+
+struct ProfileOptions {
   std::string check_path;
   bool print_default = false;
-  CLI::App* prof = cli.add_subcommand("profile", "Check a profile, or print the built-in default profile");
-  prof->add_option("file", check_path, "Profile to check");
-  prof->add_flag("--print-default", print_default, "Print the built-in default profile");
+};
 
+CLI::App* add_profile_command(CLI::App& cli, ProfileOptions& po) {
+  CLI::App* prof = cli.add_subcommand("profile", "Check a profile, or print the built-in default profile");
+  prof->add_option("file", po.check_path, "Profile to check");
+  prof->add_flag("--print-default", po.print_default, "Print the built-in default profile");
+  return prof;
+}
+
+int run_profile_command(const ProfileOptions& o) {
+  if (o.print_default) {
+    std::cout << app::default_profile_text();
+    return 0;
+  }
+  if (o.check_path.empty()) {
+    std::cerr << "lbrsim profile: give a file to check, or --print-default\n";
+    return 2;
+  }
+  const app::Profile p = app::load_profile(o.check_path);
+  std::printf("%s: ok (machine %s, %zu tools, level spacing %.4g mm)\n", o.check_path.c_str(), p.machine_kind.c_str(),
+              p.tools.size(), p.solid.level_spacing_mm);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"lbrsim " LBRSIM_VERSION " — NC machining simulator on a level-based representation (LBR)"};
+  cli.set_version_flag("--version", std::string("lbrsim ") + LBRSIM_VERSION);
+  cli.require_subcommand(1);
+  std::string log_level = "info";
+  cli.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  BatchOptions b, vb;
+  ViewCliOptions vv;
+  RunOptions ro;
+  EmulateOptions em;
+  TuneOptions to;
+  ProfileOptions po;
+  CLI::App* batch = add_batch_command(cli, b);
+  CLI::App* view = add_view_command(cli, vb, vv);
+  CLI::App* run = add_run_command(cli, ro);
+  CLI::App* emu = add_emulate_command(cli, em);
+  CLI::App* tune = add_tune_command(cli, to);
+  CLI::App* prof = add_profile_command(cli, po);
   CLI11_PARSE(cli, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
   spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
-
   try {
     if (batch->parsed()) return run_batch_command(b);
     if (view->parsed()) return run_view_command(vb, vv);
     if (run->parsed()) return run_live_command(ro);
     if (emu->parsed()) return run_emulate_command(em);
-    if (tune->parsed()) {
-      const app::Profile profile = to.profile.empty() ? app::default_profile() : app::load_profile(to.profile);
-      const nc::Toolpath path = app::load_toolpath(to.program, profile);
-      const nc::Toolpath sampled = nc::sampled_toolpath(path, app::emulator_limits(profile));
-      const double machining = nc::emulated_time_s(path, app::emulator_limits(profile));
-      double dmax = 1.0;
-      for (const auto& [n, t] : profile.tools) dmax = std::max(dmax, t.diameter_mm);
-      const auto grids = app::tune_candidates(profile, dmax);
-      std::printf("tune: %s, %zu samples, %zu grids, one kernel thread\n", to.program.c_str(), sampled.segments.size(),
-                  grids.size());
-      const auto t = app::tune_regions(profile, sampled, grids, to.repeats, [&](const app::GridTiming& g) {
-        std::printf("  %2dx%-2d  %8.3f s  factor %.5f\n", g.nx, g.ny, g.wall_s, machining > 0 ? g.wall_s / machining : 0.0);
-        std::fflush(stdout);
-      });
-      std::printf("fastest: regions = \"%dx%d\" (%.3f s)\n", t.front().nx, t.front().ny, t.front().wall_s);
-      if (!to.write.empty()) {
-        const std::string base = to.profile.empty() ? std::string(app::default_profile_text())
-                                                    : nc::read_text_file(to.profile);
-        app::write_file(to.write, app::set_regions_in_profile_text(base, t.front().nx, t.front().ny));
-        std::printf("wrote %s\n", to.write.c_str());
-      }
-      return 0;
-    }
-    if (prof->parsed()) {
-      if (print_default) {
-        std::cout << app::default_profile_text();
-        return 0;
-      }
-      if (check_path.empty()) {
-        std::cerr << "lbrsim profile: give a file to check, or --print-default\n";
-        return 2;
-      }
-      const app::Profile p = app::load_profile(check_path);
-      std::printf("%s: ok (machine %s, %zu tools, level spacing %.4g mm)\n", check_path.c_str(), p.machine_kind.c_str(),
-                  p.tools.size(), p.solid.level_spacing_mm);
-      return 0;
-    }
+    if (tune->parsed()) return run_tune_command(to);
+    if (prof->parsed()) return run_profile_command(po);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "lbrsim: error: %s\n", e.what());
     return 1;
