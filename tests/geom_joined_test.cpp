@@ -1,0 +1,192 @@
+// Joined sections (geom/src/chain_outline.cpp): consecutive vertical moves on a level are
+// written as one outline. These cases check the region it removes three ways: against the
+// exact solid (helical bore, helical entry into a pocket), against the same moves cut one
+// by one (each move then gives its own convex section, nothing is joined), and against an
+// independent height-field reference for a sloped ball-end raster.
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "test_util.hpp"
+
+using namespace lbr;
+using geom::ToolKind;
+
+namespace {
+
+constexpr double kTol = 0.001;
+
+// Helix around (cx, cy) with radius rho from z0, `turns` turns of `pitch` downwards, then one
+// flat turn at the bottom; `per_turn` chords per turn.
+std::vector<geom::Vec3> helix(double cx, double cy, double rho, double z0, double pitch, int turns, int per_turn) {
+  std::vector<geom::Vec3> p;
+  const int n = (turns + 1) * per_turn;
+  for (int i = 0; i <= n; ++i) {
+    const double a = 2.0 * test::kPi * i / per_turn;
+    const double z = z0 - pitch * std::min(static_cast<double>(i) / per_turn, static_cast<double>(turns));
+    p.push_back({cx + rho * std::cos(a), cy + rho * std::sin(a), z});
+  }
+  return p;
+}
+
+// Largest difference of level areas between two solids [mm²].
+double max_level_area_gap(const geom::LbrSolid& a, const geom::LbrSolid& b) {
+  double worst = 0.0;
+  for (int l = 0; l < a.levels(); ++l) worst = std::max(worst, std::abs(a.level_area_mm2(l) - b.level_area_mm2(l)));
+  return worst;
+}
+
+}  // namespace
+
+TEST(Joined, HelicalBoreIsTheAnnulusTimesTheDepth) {
+  // Flat Ø8 on a helix of radius 6, 5 turns of 1 mm, then a flat turn at -5: every level
+  // above -5 loses the annulus 2 <= r <= 10.
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 8), kTol);
+  const int per_turn = 720;  // chord sag 6·(1 - cos(0.25°)) = 57 nm
+  test::cut_path(s, c, helix(30, 20, 6, 0, 1, 5, per_turn), 512);
+  const double exact = test::kPi * (100.0 - 4.0) * 5.0;
+  const double perimeter = 2.0 * test::kPi * (10.0 + 2.0);
+  EXPECT_NEAR(test::removed(s), exact, 2.0 * perimeter * kTol * 5.0);
+  EXPECT_EQ(s.check_invariants(), "");
+}
+
+TEST(Joined, HelixCutInOneBatchEqualsTheMovesCutOneByOne) {
+  geom::LbrSolid joined(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  geom::LbrSolid single(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  const auto path = helix(30, 20, 5, 1, 1.5, 3, 90);
+  test::cut_path(joined, c, path, 1000);
+  test::cut_path(single, c, path, 1);
+  // Each level: the union of the same convex sections, polygonised on one grid or per
+  // section; they differ by the chord band along the perimeter at most.
+  const double perimeter = 2.0 * test::kPi * (8.0 + 2.0);
+  EXPECT_LT(max_level_area_gap(joined, single), 2.0 * perimeter * kTol);
+  EXPECT_NEAR(test::removed(joined), test::removed(single), 2.0 * perimeter * kTol * 6.0);
+  EXPECT_EQ(joined.check_invariants(), "");
+}
+
+TEST(Joined, ZigZagWithSharpTurnsEqualsTheMovesCutOneByOne) {
+  // A ramping zig-zag with reversals and 90° corners: both sides of every join kind.
+  geom::LbrSolid joined(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  geom::LbrSolid single(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Bull, 10, 2), kTol);
+  std::vector<geom::Vec3> p{{10, 10, 1}};
+  for (int i = 0; i < 12; ++i) {
+    const double z = -0.3 * i;
+    p.push_back({i % 2 == 0 ? 50.0 : 10.0, 10.0 + 1.5 * i, z});
+    p.push_back({i % 2 == 0 ? 50.0 : 10.0, 11.5 + 1.5 * i, z - 0.1});
+    p.push_back({i % 2 == 0 ? 10.0 : 50.0, 11.5 + 1.5 * i, z - 0.15});  // reversal
+  }
+  test::cut_path(joined, c, p, 1000);
+  test::cut_path(single, c, p, 1);
+  const double perimeter = 2.0 * (60.0 + 40.0);
+  EXPECT_LT(max_level_area_gap(joined, single), 2.0 * perimeter * kTol);
+  EXPECT_EQ(joined.check_invariants(), "");
+}
+
+TEST(Joined, HelicalEntryIntoAPocketLeavesThePocket) {
+  // Helical ramp (radius 2, 4 turns to -4) at the centre of a 30 x 20 pocket, then the
+  // zig-zag and finishing loop of Volume.RectangularPocketWithRoundedCorners.
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 6), kTol);
+  std::vector<geom::Vec3> p = helix(30, 20, 2, 1, 1.25, 4, 180);
+  p.push_back({18, 13, -4});
+  bool right = true;
+  for (double y = 13; y <= 27 + 1e-9; y += 2.5) {
+    const double yy = std::min(y, 27.0);
+    p.push_back({right ? 18.0 : 42.0, yy, -4});
+    p.push_back({right ? 42.0 : 18.0, yy, -4});
+    right = !right;
+  }
+  for (const geom::Vec3& q : {geom::Vec3{42, 27, -4}, {42, 13, -4}, {18, 13, -4}, {18, 27, -4}, {42, 27, -4}}) p.push_back(q);
+  test::cut_path(s, c, p, 512);
+  const double exact = (30.0 * 20.0 - (4.0 - test::kPi) * 9.0) * 4.0;
+  EXPECT_NEAR(test::removed(s), exact, 2 * 100.0 * kTol * 4.0);
+  EXPECT_EQ(s.check_invariants(), "");
+}
+
+namespace {
+
+// Lowest point of a ball (radius r) whose centre runs from a to b, above (x, y); +inf where
+// the ball does not pass over it. z(t) - sqrt(r² - d(t)²) is convex in t: ternary search.
+double ball_floor(double x, double y, const geom::Vec3& a, const geom::Vec3& b, double r) {
+  auto f = [&](double t) {
+    const double cx = a.x + t * (b.x - a.x), cy = a.y + t * (b.y - a.y), cz = a.z + t * (b.z - a.z);
+    const double d2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+    return d2 >= r * r ? INFINITY : cz - std::sqrt(r * r - d2);
+  };
+  // Closest approach in XY first: the floor is finite near it when it is finite at all.
+  const double dx = b.x - a.x, dy = b.y - a.y, l2 = dx * dx + dy * dy;
+  const double t0 = l2 > 0.0 ? std::clamp(((x - a.x) * dx + (y - a.y) * dy) / l2, 0.0, 1.0) : 0.0;
+  if (!std::isfinite(f(t0))) return INFINITY;
+  double lo = 0.0, hi = 1.0;
+  // The finite interval around t0 (d(t) < r) is where the search runs.
+  for (double* e : {&lo, &hi}) {
+    double in = t0, out = *e;
+    if (std::isfinite(f(out))) continue;
+    for (int i = 0; i < 60; ++i) {
+      const double m = 0.5 * (in + out);
+      (std::isfinite(f(m)) ? in : out) = m;
+    }
+    *e = in;
+  }
+  for (int i = 0; i < 60 && hi - lo > 1e-10; ++i) {
+    const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
+    if (f(m1) < f(m2)) hi = m2;
+    else lo = m1;
+  }
+  return f(0.5 * (lo + hi));
+}
+
+}  // namespace
+
+TEST(Joined, SlopedBallRasterMatchesAHeightFieldReference) {
+  // Ball Ø6 raster over z = -2.5 + 1.5·sin(x/4)·cos(y/3) (slopes up to ~25°), 0.25 mm
+  // points, 0.5 mm stepover, 12 lines; the reference integrates the lower envelope of the
+  // balls on a 0.04 mm grid.
+  const double R = 3.0;
+  geom::LbrSolid s(test::box_spec({0, 0, -8}, {30, 20, 0}, 0.1, 4, 2));
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Ball, 2 * R, 0.0, 18.0), kTol);
+  auto surf = [](double x, double y) { return -2.5 + 1.5 * std::sin(x / 4.0) * std::cos(y / 3.0); };
+  std::vector<std::vector<geom::Vec3>> lines;
+  for (int j = 0; j < 12; ++j) {
+    const double y = 7.0 + 0.5 * j;
+    std::vector<geom::Vec3> line;
+    for (int i = 0; i <= 64; ++i) {
+      const double x = j % 2 == 0 ? 7.0 + 0.25 * i : 23.0 - 0.25 * i;
+      line.push_back({x, y, surf(x, y)});  // tip on the surface
+    }
+    lines.push_back(line);
+  }
+  std::vector<geom::Vec3> path;
+  for (const auto& l : lines) path.insert(path.end(), l.begin(), l.end());
+  test::cut_path(s, c, path, 512);
+  // The moves from one line to the next cut too: two-point lines for the reference.
+  for (std::size_t j = 0; j + 1 < 12; ++j) lines.push_back({lines[j].back(), lines[j + 1].front()});
+  // Reference: tip z + R is the ball centre. Per grid point only the lines within R in y
+  // and their moves within R in x can reach it (lines are straight in XY, 0.25 mm steps).
+  const double h = 0.04;  // the cut lies within x 4..26, y 4..15.5; grid points at cell centres
+  double ref = 0.0;
+  for (double y = 4.0 + 0.5 * h; y < 15.6; y += h)
+    for (double x = 4.0 + 0.5 * h; x < 26.0; x += h) {
+      double floor = INFINITY;
+      for (const auto& line : lines) {
+        if (std::min(line.front().y, line.back().y) - y >= R || y - std::max(line.front().y, line.back().y) >= R) continue;
+        for (std::size_t k = 1; k < line.size(); ++k) {
+          const geom::Vec3& a0 = line[k - 1];
+          const geom::Vec3& b0 = line[k];
+          if (std::max(a0.x, b0.x) <= x - R || std::min(a0.x, b0.x) >= x + R) continue;
+          floor = std::min(floor, ball_floor(x, y, {a0.x, a0.y, a0.z + R}, {b0.x, b0.y, b0.z + R}, R));
+        }
+      }
+      // The retract between lines (up to z = 1) cuts nothing: its ball stays above the top.
+      if (floor < 0.0) ref += (0.0 - std::max(floor, -8.0)) * h * h;
+    }
+  const double v = test::removed(s);
+  ASSERT_GT(ref, 300.0);
+  EXPECT_NEAR(v, ref, 0.0005 * ref) << "lbr " << v << " reference " << ref;
+  RecordProperty("relative_error", std::to_string((v - ref) / ref));
+  EXPECT_EQ(s.check_invariants(), "");
+}
