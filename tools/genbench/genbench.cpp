@@ -1,11 +1,16 @@
-// lbr-genbench — writes the benchmark part programs low.ngc, medium.ngc and high.ngc
-// (docs/benchmarks.md): analogues of the paper's three test models whose machining times
-// under the machine emulator (default 3-axis profile) match the paper's: 170 s, 210 s, 450 s.
-// Each program's feed rates are scaled by a bisection until the emulated time is within 0.5 %
-// of its target. Deterministic: the same build writes the same bytes.
+// lbr-genbench — writes the benchmark part programs (docs/benchmarks.md):
+//  - low.ngc, medium.ngc, high.ngc: analogues of the paper's three test models whose machining
+//    times under the machine emulator (default 3-axis profile) match the paper's: 170 s, 210 s,
+//    450 s. Each program's feed rates are scaled by a bisection until the emulated time is
+//    within 0.5 % of its target.
+//  - finish3d.ngc, helix.ngc (default 3-axis profile) and finish5x.ngc (mill5-ac profile plus
+//    two tools given on the command line): the workloads of issue 13, at fixed feed rates.
+// Deterministic: the same build writes the same bytes.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <functional>
 #include <numbers>
@@ -59,8 +64,10 @@ class Program {
 };
 
 // Zig-zag over the tool-centre rectangle at depth z, stepover s, then the finishing loop.
-void zigzag_pocket(Program& p, double x0, double y0, double x1, double y1, double z, double s, double safe) {
-  p.rapid(x0, y0, safe);
+// entered: the tool is already down in the pocket (no rapid to the start above it).
+void zigzag_pocket(Program& p, double x0, double y0, double x1, double y1, double z, double s, double safe,
+                   bool entered = false) {
+  if (!entered) p.rapid(x0, y0, safe);
   p.line(x0, y0, z);
   bool right = true;
   for (double y = y0;; y = std::min(y + s, y1)) {
@@ -257,6 +264,318 @@ std::string high(double scale) {
   return p.out.str();
 }
 
+// ---- Issue 13 workloads: finish3d, helix (default profile), finish5x (mill5-ac) ----
+
+// Milling cutter with a vertical axis: corner == radius is a ball, 0 < corner < radius a bull.
+struct Cutter {
+  double radius, corner;
+};
+
+// Height of the cutter's lower surface above its tip at radial distance rho <= radius.
+double lower_surface(const Cutter& c, double rho) {
+  const double flat = c.radius - c.corner;
+  if (rho <= flat) return 0.0;
+  const double u = rho - flat;
+  return c.corner - std::sqrt(std::max(0.0, c.corner * c.corner - u * u));
+}
+
+// Lowest tip height at (x, y) of a vertical cutter that does not gouge `f`: the surface sampled
+// at 217 points of the cutter's footprint (8 rings of 6i points).
+template <class F>
+double drop_cutter(const F& f, double x, double y, const Cutter& c) {
+  double z = f(x, y);
+  constexpr int kRings = 8;
+  for (int i = 1; i <= kRings; ++i) {
+    const double rho = c.radius * i / kRings, h = lower_surface(c, rho);
+    const int n = 6 * i;
+    for (int k = 0; k < n; ++k) {
+      const double a = 2 * std::numbers::pi * (k + 0.5 * (i % 2)) / n;
+      z = std::max(z, f(x + rho * std::cos(a), y + rho * std::sin(a)) - h);
+    }
+  }
+  return z;
+}
+
+// Free-form of finish3d [mm]: a bump (flanks up to ~36°) with a ripple (~8° more), Z -11.5 .. -0.5.
+double surface3d(double x, double y) {
+  const double dx = x - 50, dy = y - 40;
+  return -10.5 + 9.0 * std::exp(-(dx * dx + dy * dy) / 110.0) + std::sin(x / 7.0) * std::cos(y / 9.0);
+}
+
+// Steepest slope of surface3d over [x0, x1] x [y0, y1] [deg] (central differences, 0.1 mm grid).
+double max_slope_deg(double x0, double y0, double x1, double y1) {
+  double g = 0.0;
+  for (double x = x0; x <= x1 + 1e-9; x += 0.1)
+    for (double y = y0; y <= y1 + 1e-9; y += 0.1) {
+      const double e = 1e-4;
+      const double gx = (surface3d(x + e, y) - surface3d(x - e, y)) / (2 * e);
+      const double gy = (surface3d(x, y + e) - surface3d(x, y - e)) / (2 * e);
+      g = std::max(g, std::hypot(gx, gy));
+    }
+  return std::atan(g) * 180.0 / std::numbers::pi;
+}
+
+// Motion blocks (G0, G1, G2, G3) of a program.
+long count_moves(const std::string& text) {
+  long n = 0;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);)
+    if (l.size() > 2 && l[0] == 'G' && l[1] >= '0' && l[1] <= '3' && l[2] == ' ') ++n;
+  return n;
+}
+
+// One raster line: rapid over, rapid down to 1 mm above, plunge, follow, retract.
+// along_x: the points vary in X at fixed `across` = Y (else in Y at fixed X).
+void raster_line(Program& p, bool along_x, double across, const std::vector<double>& s,
+                 const std::vector<double>& z, double safe) {
+  const auto xy = [&](std::size_t i) { return along_x ? std::pair{s[i], across} : std::pair{across, s[i]}; };
+  p.out << "G0 X" << Program::num(xy(0).first) << " Y" << Program::num(xy(0).second) << "\n";
+  p.out << "G0 Z" << Program::num(z[0] + 1.0) << "\n";
+  p.out << "G1 Z" << Program::num(z[0]) << "\n";
+  const char* w = along_x ? " X" : " Y";
+  for (std::size_t i = 1; i < s.size(); ++i) p.out << "G1" << w << Program::num(s[i]) << " Z" << Program::num(z[i]) << "\n";
+  p.rapid_z(safe);
+}
+
+// Dense raster with `c` along X (along_x) or Y over the rectangle, point spacing `ds`,
+// stepover `so`, alternating direction, G0 retracts to `safe` between lines.
+template <class F>
+void raster(Program& p, const F& f, const Cutter& c, bool along_x, double s0, double s1, double ds, double a0,
+            double a1, double so, double safe) {
+  const int ns = static_cast<int>(std::lround((s1 - s0) / ds)), na = static_cast<int>(std::lround((a1 - a0) / so));
+  for (int j = 0; j <= na; ++j) {
+    const double across = a0 + so * j;
+    std::vector<double> s, z;
+    for (int i = 0; i <= ns; ++i) {
+      const int k = j % 2 == 0 ? i : ns - i;
+      s.push_back(s0 + ds * k);
+      z.push_back(along_x ? drop_cutter(f, s.back(), across, c) : drop_cutter(f, across, s.back(), c));
+    }
+    raster_line(p, along_x, across, s, z, safe);
+  }
+}
+
+std::string finish3d(long& moves) {
+  Program p(1.0);
+  p.header("finish3d: dense 3D finishing of a free-form with slopes up to " + Program::num(std::round(max_slope_deg(10, 10, 90, 70))) +
+           " deg - bull-nose raster along Y, ball-end raster along X, ball-end waterline; 0.25 mm point spacing, 0.4 mm "
+           "stepover");
+  constexpr double kSafe = 2.0;
+  const Cutter ball{3.0, 3.0}, bull{6.0, 2.0};
+  // T5 bull-nose Ø12 R2 over the bump's middle.
+  p.tool(5, 10000);
+  p.rapid_z(kSafe);
+  p.feed(1500);
+  raster(p, surface3d, bull, false, 22.0, 58.0, 0.25, 30.0, 70.0, 0.4, kSafe);
+  // T2 ball Ø6 over most of the part.
+  p.tool(2, 15000);
+  p.rapid_z(kSafe);
+  p.feed(2000);
+  raster(p, surface3d, ball, true, 10.0, 90.0, 0.25, 20.0, 60.0, 0.4, kSafe);
+  // Waterline: constant-Z contours of the ball around the bump every 0.5 mm, 0.25 mm spacing.
+  const auto drop = [&](double x, double y) { return drop_cutter(surface3d, x, y, ball); };
+  for (int level = 0; level <= 12; ++level) {
+    const double z = -2.0 - 0.5 * level;
+    const auto radius_at = [&](double a) {  // contour radius from the bump centre (bisection)
+      double lo = 0.0, hi = 34.0;
+      for (int i = 0; i < 40; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        if (drop(50 + mid * std::cos(a), 40 + mid * std::sin(a)) > z) lo = mid;
+        else hi = mid;
+      }
+      return 0.5 * (lo + hi);
+    };
+    const int pts = static_cast<int>(std::ceil(2 * std::numbers::pi * radius_at(0.0) / 0.25));
+    std::vector<std::pair<double, double>> c;
+    for (int i = 0; i < pts; ++i) {
+      const double a = 2 * std::numbers::pi * i / pts, r = radius_at(a);
+      c.push_back({50 + r * std::cos(a), 40 + r * std::sin(a)});
+    }
+    p.out << "G0 X" << Program::num(c[0].first) << " Y" << Program::num(c[0].second) << "\n";
+    p.out << "G0 Z" << Program::num(z + 1.0) << "\n";
+    p.out << "G1 Z" << Program::num(z) << "\n";
+    for (std::size_t i = 1; i <= c.size(); ++i) {
+      const auto& q = c[i % c.size()];
+      p.out << "G1 X" << Program::num(q.first) << " Y" << Program::num(q.second) << "\n";
+    }
+    p.rapid_z(kSafe);
+  }
+  p.end();
+  moves = count_moves(p.out.str());
+  return p.out.str();
+}
+
+// Helix of `halves` half turns about (cx, cy) at radius r from z0 to z1 (G2 when cw), starting
+// at angle 0 (x = cx + r): each half turn one G2/G3 block with Z.
+void helix_turns(Program& p, double cx, double cy, double r, double z0, double z1, int halves, bool cw) {
+  for (int k = 1; k <= halves; ++k) {
+    const double x = k % 2 == 1 ? cx - r : cx + r;
+    const double from = k % 2 == 1 ? cx + r : cx - r;
+    const double z = z0 + (z1 - z0) * k / halves;
+    p.out << (cw ? "G2" : "G3") << " X" << Program::num(x) << " Y" << Program::num(cy) << " Z" << Program::num(z) << " I"
+          << Program::num(cx - from) << " J0\n";
+  }
+}
+
+// Full circle (two half turns) at constant Z, starting and ending at (cx + r, cy).
+void circle_at(Program& p, double cx, double cy, double r, double z) {
+  helix_turns(p, cx, cy, r, z, z, 2, false);
+}
+
+std::string helix(long& moves) {
+  Program p(1.0);
+  p.header("helix: helical ramp entries into pockets, helical bores, thread milling - G2/G3 with Z");
+  constexpr double kSafe = 2.0;
+  p.tool(1, 12000);
+  // Round pocket Ø40 at (28, 28): per step-down a helical ramp (radius 4, 1 mm per turn),
+  // a flat circle, then concentric circles out to the wall.
+  const double pcx = 28, pcy = 28;
+  double ztop = 0.5;
+  for (double zb : {-6.0, -12.0}) {
+    p.rapid(pcx + 4, pcy, kSafe);
+    p.rapid_z(ztop);
+    p.feed(800);
+    const int halves = 2 * static_cast<int>(std::ceil(ztop - zb));  // whole turns: ends at angle 0
+    helix_turns(p, pcx, pcy, 4, ztop, zb, halves, false);
+    circle_at(p, pcx, pcy, 4, zb);
+    p.feed(1200);
+    for (double r : {8.0, 12.0, 15.0}) {
+      p.line(pcx + r, pcy, zb);
+      circle_at(p, pcx, pcy, r, zb);
+    }
+    p.rapid_z(kSafe);
+    ztop = zb + 0.5;
+  }
+  // Rectangular pocket 36 x 28 (x 54..90, y 42..70), 5 mm deep: helical ramp at the centre
+  // (radius 3, 15 half turns), zig-zag at 50 % stepover, finishing loop.
+  p.rapid(75, 56, kSafe);
+  p.rapid_z(1.0);
+  p.feed(800);
+  helix_turns(p, 72, 56, 3, 1.0, -5.0, 15, false);
+  p.feed(1200);
+  zigzag_pocket(p, 59, 47, 85, 65, -5.0, 5.0, kSafe, true);
+  // Helical bores: Ø16 at (20, 66), 5 turns to Z-10; Ø22 at (84, 16), 5 turns to Z-12.5.
+  struct Bore {
+    double cx, cy, r, depth;
+  };
+  const Bore bores[] = {{20, 66, 3.0, -10.0}, {84, 16, 6.0, -12.5}};
+  p.feed(600);
+  for (const Bore& b : bores) {
+    p.rapid(b.cx + b.r, b.cy, kSafe);
+    p.rapid_z(0.5);
+    helix_turns(p, b.cx, b.cy, b.r, 0.5, b.depth, 10, true);
+    circle_at(p, b.cx, b.cy, b.r, b.depth);
+    p.line(b.cx, b.cy, b.depth);
+    p.rapid_z(kSafe);
+  }
+  // Thread milling in the two bores with the Ø6 ball: pitch 1.5 mm, climbing from the bottom,
+  // 0.8 mm deep (helix radius = bore radius - 3 + 0.8).
+  p.tool(2, 15000);
+  p.feed(500);
+  for (const Bore& b : bores) {
+    const double r = b.r + 5.0 - 3.0 + 0.8, z0 = b.depth + 1.5, turns = b.r > 4 ? 6 : 5;
+    p.rapid(b.cx, b.cy, kSafe);
+    p.rapid_z(z0);
+    p.line(b.cx + r, b.cy, z0);
+    helix_turns(p, b.cx, b.cy, r, z0, z0 + 1.5 * turns, static_cast<int>(2 * turns), false);
+    p.line(b.cx, b.cy, z0 + 1.5 * turns);
+    p.rapid_z(kSafe);
+  }
+  p.end();
+  moves = count_moves(p.out.str());
+  return p.out.str();
+}
+
+// Free-form of finish5x in the workpiece frame (mill5-ac stock 60 x 60 x 30, top at Z0).
+double surface5x(double x, double y) { return -6.0 + 3.0 * std::cos(x / 8.0) * std::cos(y / 10.0); }
+
+// Rotation about X by `deg` (kin::tool_pose's rot_x): table-ac with C0 and the rotary centre at
+// the origin maps machine point p to workpiece point rot_x(p, -A), so p = rot_x(tip, A).
+std::array<double, 3> rot_x(const std::array<double, 3>& v, double deg) {
+  const double c = std::cos(deg * std::numbers::pi / 180.0), s = std::sin(deg * std::numbers::pi / 180.0);
+  return {v[0], c * v[1] - s * v[2], s * v[1] + c * v[2]};
+}
+
+// Lowest tip height at (x, y) of a cutter whose axis is tilted by A (workpiece axis (0, sin A,
+// cos A)): its lower surface sampled in the tool frame, turned into the workpiece frame.
+double drop_tilted(double x, double y, const Cutter& c, double a_deg) {
+  double z = surface5x(x, y);
+  constexpr int kRings = 8;
+  for (int i = 1; i <= kRings; ++i) {
+    const double rho = c.radius * i / kRings, h = lower_surface(c, rho);
+    const int n = 6 * i;
+    for (int k = 0; k < n; ++k) {
+      const double a = 2 * std::numbers::pi * (k + 0.5 * (i % 2)) / n;
+      const auto d = rot_x({rho * std::cos(a), rho * std::sin(a), h}, -a_deg);
+      z = std::max(z, surface5x(x + d[0], y + d[1]) - d[2]);
+    }
+  }
+  return z;
+}
+
+// One 5-axis raster line: tips (workpiece frame) and tilts, written as machine X Y Z A.
+void line5x(Program& p, const std::vector<std::array<double, 3>>& tips, const std::vector<double>& tilt) {
+  auto m = [&](std::size_t i) { return rot_x(tips[i], tilt[i]); };
+  const auto q0 = m(0);
+  p.out << "G0 X" << Program::num(q0[0]) << " Y" << Program::num(q0[1]) << " A" << Program::num(tilt[0]) << "\n";
+  p.out << "G0 Z" << Program::num(q0[2] + 1.0) << "\n";
+  p.out << "G1 Z" << Program::num(q0[2]) << "\n";
+  for (std::size_t i = 1; i < tips.size(); ++i) {
+    const auto q = m(i);
+    p.out << "G1 X" << Program::num(q[0]) << " Y" << Program::num(q[1]) << " Z" << Program::num(q[2]) << " A"
+          << Program::num(tilt[i]) << "\n";
+  }
+  p.rapid_z(20.0);
+}
+
+std::string finish5x(long& moves) {
+  Program p(1.0);
+  p.header("finish5x: 5-axis finishing of a free-form on config/profiles/mill5-ac.toml with --tool 3:ball:6 --tool "
+           "4:bull:10:2 - tilted ball raster along X with A = 20 sin, tilted bull raster along Y with A = 15 sin; machine "
+           "axes, no TCP");
+  p.out << "G0 Z20 A0 C0\n";
+  // T3 ball Ø6 along X: the ball's centre does not depend on the tilt, the tip is the centre
+  // minus the radius along the tilted axis.
+  p.tool(3, 15000);
+  p.out << "G0 Z20\n";
+  p.feed(2000);
+  const Cutter ball{3.0, 3.0}, bull{5.0, 2.0};
+  for (int j = 0; j <= 24; ++j) {
+    const double y = -24.0 + 2.0 * j;
+    std::vector<std::array<double, 3>> tips;
+    std::vector<double> tilt;
+    for (int i = 0; i <= 108; ++i) {
+      const int k = j % 2 == 0 ? i : 108 - i;
+      const double x = -27.0 + 0.5 * k, a = 20.0 * std::sin(std::numbers::pi * x / 27.0);
+      const double cz = drop_cutter(surface5x, x, y, ball) + 3.0;
+      const double ar = a * std::numbers::pi / 180.0;
+      tips.push_back({x, y - 3.0 * std::sin(ar), cz - 3.0 * std::cos(ar)});
+      tilt.push_back(a);
+    }
+    line5x(p, tips, tilt);
+  }
+  // T4 bull Ø10 R2 along Y, tilt varying along the line.
+  p.tool(4, 12000);
+  p.out << "G0 Z20\n";
+  p.feed(1500);
+  for (int j = 0; j <= 10; ++j) {
+    const double x = -20.0 + 4.0 * j;
+    std::vector<std::array<double, 3>> tips;
+    std::vector<double> tilt;
+    for (int i = 0; i <= 96; ++i) {
+      const int k = j % 2 == 0 ? i : 96 - i;
+      const double y = -24.0 + 0.5 * k, a = 15.0 * std::sin(std::numbers::pi * y / 24.0);
+      tips.push_back({x, y, drop_tilted(x, y, bull, a)});
+      tilt.push_back(a);
+    }
+    line5x(p, tips, tilt);
+  }
+  p.out << "G0 Z50 A0\n";
+  p.end();
+  moves = count_moves(p.out.str());
+  return p.out.str();
+}
+
 double emulated_time(const std::string& text, const Profile& prof) {
   const lbr::nc::Toolpath tp = lbr::nc::interpret_gcode(text, "gen", lbr::app::gcode_options(prof));
   return lbr::nc::emulated_time_s(tp, lbr::app::emulator_limits(prof));
@@ -265,11 +584,23 @@ double emulated_time(const std::string& text, const Profile& prof) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App cli{"lbr-genbench: write the benchmark part programs low/medium/high.ngc"};
-  std::string dir = "bench/programs";
+  CLI::App cli{"lbr-genbench: write the benchmark part programs (docs/benchmarks.md)"};
+  std::string dir = "bench/programs", mill5 = LBR_GENBENCH_MILL5_PROFILE;
   cli.add_option("--out", dir, "Output directory")->capture_default_str();
+  cli.add_option("--mill5-profile", mill5, "Profile finish5x is timed on (plus --tool 3:ball:6 --tool 4:bull:10:2)")
+      ->capture_default_str();
   CLI11_PARSE(cli, argc, argv);
   const Profile prof = lbr::app::default_profile();
+  const auto write = [&](const char* name, const std::string& text) {
+    const std::string path = dir + "/" + name + ".ngc";
+    std::ofstream f(path, std::ios::binary);
+    f << text;
+    if (!f) {
+      std::fprintf(stderr, "lbr-genbench: cannot write %s\n", path.c_str());
+      return false;
+    }
+    return true;
+  };
   struct W {
     const char* name;
     double target_s;
@@ -287,15 +618,36 @@ int main(int argc, char** argv) {
     }
     const std::string text = w.gen(hi);
     const double t = emulated_time(text, prof);
-    const std::string path = dir + "/" + w.name + ".ngc";
-    std::ofstream f(path, std::ios::binary);
-    f << text;
-    if (!f) {
-      std::fprintf(stderr, "lbr-genbench: cannot write %s\n", path.c_str());
-      return 1;
-    }
-    std::printf("%-7s %8.2f s machining (target %.0f s), feed scale %.4f, %zu bytes -> %s\n", w.name, t, w.target_s, hi,
-                text.size(), path.c_str());
+    if (!write(w.name, text)) return 1;
+    std::printf("%-8s %8.2f s machining (target %.0f s), feed scale %.4f, %zu bytes -> %s/%s.ngc\n", w.name, t, w.target_s,
+                hi, text.size(), dir.c_str(), w.name);
+  }
+  // Issue 13 workloads: fixed feeds, timed by the emulator on their profile.
+  Profile prof5;
+  bool have5 = true;
+  try {
+    prof5 = lbr::app::load_profile(mill5);
+    lbr::app::apply_tool_override(prof5, "3:ball:6");
+    lbr::app::apply_tool_override(prof5, "4:bull:10:2");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lbr-genbench: %s: finish5x not timed\n", e.what());
+    have5 = false;
+  }
+  struct F {
+    const char* name;
+    std::string (*gen)(long&);
+    const Profile* profile;
+  };
+  const F fixed[] = {{"finish3d", finish3d, &prof}, {"helix", helix, &prof}, {"finish5x", finish5x, have5 ? &prof5 : nullptr}};
+  for (const F& w : fixed) {
+    long moves = 0;
+    const std::string text = w.gen(moves);
+    if (!write(w.name, text)) return 1;
+    if (w.profile != nullptr)
+      std::printf("%-8s %8.2f s machining, %ld moves, %zu bytes -> %s/%s.ngc\n", w.name, emulated_time(text, *w.profile),
+                  moves, text.size(), dir.c_str(), w.name);
+    else
+      std::printf("%-8s %ld moves, %zu bytes -> %s/%s.ngc\n", w.name, moves, text.size(), dir.c_str(), w.name);
   }
   return 0;
 }
