@@ -123,7 +123,8 @@ t = time.perf_counter() - t0
 vol = None
 try:
     m = sim.GetResultMesh()[0]
-    vol = 100 * 80 * 30 - abs(m.Volume)
+    v = 100 * 80 * 30 - m.Volume
+    vol = v if 0 < v < 100 * 80 * 30 else None  # the result mesh is not always closed
 except Exception as e:  # the mesh is a bonus; the time is the figure
     sys.stderr.write("volume: %s\n" % e)
 with open(out, "w") as f:
