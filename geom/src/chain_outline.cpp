@@ -1,6 +1,10 @@
 // The outline of a run of consecutive vertical moves on one level (chain_outline.hpp).
 #include "chain_outline.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
 namespace lbr::geom::detail {
 
 namespace {
@@ -24,15 +28,31 @@ struct Walker {
   }
   // From vertex a to vertex b of the shared disk: along the disk when a lies on the cap
   // interval [lo, hi] of the other move (the outer side of the turn), else through the
-  // centre (the inner side).
-  void join(P2 c, double rho, int a, int b, int lo, int hi) {
+  // centre (the inner side). `direct`: the inner side may take the chord a-b instead.
+  void join(P2 c, double rho, int a, int b, int lo, int hi, bool direct) {
     if (on_arc(a, lo, hi, n)) {
       arc(c, rho, a, b);
       return;
     }
     vertex(c, rho, a);
-    buf.push_back(c);
+    if (!direct || !chord_is_covered(rho, (a - b + n) % n)) buf.push_back(c);
     vertex(c, rho, b);
+  }
+  // The inner side of a join between two stadiums (moves k and k+1 at the shared disk,
+  // centre c, turning by `steps` grid steps, α): the path through c and the chord a-b
+  // differ by the triangle (c, b, a) inside the shared disk. The triangle lies in both
+  // stadiums and outside the four caps that the outline replaces by spokes when
+  // ρ·sin α < L·cos(2π/n) for both move lengths L: the spoke of a move's far cap has the
+  // direction of the near spoke, and the line through the far centre along it separates
+  // the far cap from the triangle (docs/lbr-conventions.md, "Joined sections"). The
+  // triangle is then covered twice and the chord leaves it covered once. A spoke to c
+  // crosses every neighbouring side within ρ of it; the chord crosses none.
+  double shorter = 0.0;  // the shorter of the two moves at this join [mm]
+  bool chord_is_covered(double rho, int steps) const {
+    const double step = 2.0 * std::numbers::pi / n;
+    const double alpha = steps * step;
+    if (alpha >= 0.25 * std::numbers::pi) return false;
+    return rho * std::sin(alpha) < 0.9 * std::cos(step) * shorter;
   }
   void side(const std::vector<P2>& pts) { buf.insert(buf.end(), pts.begin(), pts.end()); }
 };
@@ -91,7 +111,8 @@ bool append_outline(std::span<const MoveCaps> moves, int n, const std::vector<P2
     w.side(a.right);
     if (k + 1 < m) {
       const MoveCaps& b = moves[k + 1];
-      w.join(a.c1, a.rho1, a.front_r, b.back_r, b.back_l, b.back_r);
+      w.shorter = std::min(a.length, b.length);
+      w.join(a.c1, a.rho1, a.front_r, b.back_r, b.back_l, b.back_r, a.uniform && b.uniform);
     }
   }
   // Front cap of the last move, then the left sides back.
@@ -101,7 +122,8 @@ bool append_outline(std::span<const MoveCaps> moves, int n, const std::vector<P2
     w.side(b.left);
     if (k > 0) {
       const MoveCaps& a = moves[k - 1];
-      w.join(b.c0, b.rho0, b.back_l, a.front_l, a.front_r, a.front_l);
+      w.shorter = std::min(a.length, b.length);
+      w.join(b.c0, b.rho0, b.back_l, a.front_l, a.front_r, a.front_l, a.uniform && b.uniform);
     }
   }
   return emit_path(buf, out, spare);
