@@ -32,6 +32,8 @@ inline void cpu_relax() noexcept {
 }
 
 constexpr std::uint32_t kNoChain = 0xFFFFFFFFu;
+// Sections with at least this many vertices are cut to the region before a clip.
+constexpr std::size_t kCutSectionVertices = 64;
 
 bool same_contour(const Contour& a, const Contour& b) noexcept { return a.cut_by == b.cut_by && a.pts == b.pts; }
 
@@ -709,8 +711,9 @@ void LbrSolid::build_run_sections(double zc, std::pair<std::uint32_t, std::uint3
     }
     // Joined outline from si, when si and at least the next move share their joint disk.
     if (run.second - si >= 2) {
-      // One angle grid along the run: the tool's full radius sets it.
-      const int grid = Sweep::circle_segments(sw.shape().radius(), sw.shape().chord_tol_mm);
+      // One angle grid along the run: the tool's full radius sets it. Even, so that a
+      // stadium's caps are exact half turns (chain_outline.cpp, chord_is_covered()).
+      const int grid = (Sweep::circle_segments(sw.shape().radius(), sw.shape().chord_tol_mm) + 1) / 2 * 2;
       if (ws.caps.size() < run.second - si) ws.caps.resize(run.second - si);
       std::size_t count = 0;
       while (si + count < run.second && sh.sweeps[si + count].section_caps(zc, grid, ws.scratch, ws.caps[count]) &&
@@ -841,9 +844,24 @@ bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, Subtrac
     c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
     for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
   }
+  // Long sections that reach well beyond the region (a joined outline runs along a whole
+  // pass) are cut to the region grown by 1 mm first: the clip then carries only the nearby
+  // edges. The cut keeps the winding inside the grown region, where the cell lies.
+  const Rect grown = [&] {
+    const Rect rr = region_rect(region);
+    const Coord g = static_cast<Coord>(kUnitsPerMm);
+    return Rect{rr.x0 - g, rr.y0 - g, rr.x1 + g, rr.y1 + g};
+  }();
   for (std::uint32_t k : ws.selected) {
     if (ls.chain[k] == kNoChain) {
-      c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
+      const Rect& b = ls.box[k];
+      const bool inside = b.x0 >= grown.x0 && b.x1 <= grown.x1 && b.y0 >= grown.y0 && b.y1 <= grown.y1;
+      if (inside || ls.paths[k].size() < kCutSectionVertices) {
+        c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
+      } else {
+        detail::cut_to_rect(ls.paths[k], grown, ws.cut, ws.cut_tmp);
+        if (ws.cut.size() >= 3) c.AddPath(ws.cut, ClipperLib::ptClip, true);
+      }
     } else {
       c.AddPaths(offset_piece(sh, ls.chain[k], region, ws), ClipperLib::ptClip, true);
     }

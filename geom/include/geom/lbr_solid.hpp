@@ -184,6 +184,7 @@ struct SubtractWorkspace {
   SectionScratch scratch;
   std::vector<MoveCaps> caps;                 // one per move of a joined run
   std::vector<SectionScratch::P2> outline;    // a joined run's vertices before rounding
+  Path cut, cut_tmp;                          // a long section cut to a region
   std::vector<std::uint8_t> trim_flags;
   std::vector<int> source;          // per (level - lb, region): the level whose result it takes
   std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip
