@@ -120,8 +120,12 @@ struct Hull3 {
     }
     return bp;
   }
-  // Boundary point of the section of the hull by z = zc in in-plane direction (cos φ, sin φ).
-  P2 section_point(double phi, double zc) const noexcept {
+  // Boundary point of the section of the hull by z = zc in in-plane direction (cos φ, sin φ),
+  // to about `eps` [mm]. The point is interpolated on the chord between the support points
+  // below and above the plane; the bisection on the tilt halves its distance to the
+  // boundary each step, so it stops once a step moves the point by less than eps/2 (the
+  // steps left would move it by about as much in all).
+  P2 section_point(double phi, double zc, double eps) const noexcept {
     const double ux = std::cos(phi), uy = std::sin(phi);
     auto sup = [&](double t) { return support(Vec3{ux, uy, t}); };
     double tlo = -1.0, thi = 1.0;
@@ -138,6 +142,14 @@ struct Hull3 {
       thi *= 2.0;
       phi_ = sup(thi);
     }
+    auto interpolate = [&] {
+      const double dz = phi_.z - plo.z;
+      if (!(dz > 1e-12)) return P2{plo.x, plo.y};
+      const double w = std::clamp((zc - plo.z) / dz, 0.0, 1.0);
+      return P2{plo.x + w * (phi_.x - plo.x), plo.y + w * (phi_.y - plo.y)};
+    };
+    const double stop2 = 0.25 * eps * eps;
+    P2 last = interpolate();
     for (int i = 0; i < 64 && thi - tlo > 1e-13 * (1.0 + std::abs(tlo)); ++i) {
       const double tm = 0.5 * (tlo + thi);
       const Vec3 pm = sup(tm);
@@ -148,13 +160,12 @@ struct Hull3 {
         thi = tm;
         phi_ = pm;
       }
+      const P2 now = interpolate();
+      const double dx = now.x - last.x, dy = now.y - last.y;
+      last = now;
+      if (i >= 4 && dx * dx + dy * dy <= stop2) break;
     }
-    const double dz = phi_.z - plo.z;
-    if (dz > 1e-12) {
-      const double w = std::clamp((zc - plo.z) / dz, 0.0, 1.0);
-      return {plo.x + w * (phi_.x - plo.x), plo.y + w * (phi_.y - plo.y)};
-    }
-    return {plo.x, plo.y};
+    return last;
   }
 };
 
@@ -561,6 +572,9 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) co
     }
     if (zc < zlo || zc > zhi) continue;
     const Hull3 hull{circles, nc};
+    // Boundary points to 1/20 of the chord tolerance: the refinement below splits where a
+    // point lies farther than tol/2 from its chord.
+    constexpr double kPointEps = 0.05;
     // Adaptive refinement in angle: start with 16 directions, split an interval while the
     // boundary point at its middle lies farther than tol/2 from the chord.
     sc.dirs.clear();
@@ -568,7 +582,7 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) co
     constexpr int kMaxPoints = 8192;
     for (int i = 0; i <= kStart; ++i) {
       const double phi = 2.0 * std::numbers::pi * i / kStart;
-      sc.dirs.push_back({phi, i == kStart ? sc.dirs.front().p : hull.section_point(phi, zc)});
+      sc.dirs.push_back({phi, i == kStart ? sc.dirs.front().p : hull.section_point(phi, zc, kPointEps * tol)});
     }
     sc.pts.clear();
     // Depth-first refinement using `hull` storage as a stack of intervals (reused buffer).
@@ -584,7 +598,7 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) co
       while (sp > 0) {
         const Iv iv = stack[--sp];
         const double pm = 0.5 * (iv.pa + iv.pb);
-        const P2 m = hull.section_point(pm, zc);
+        const P2 m = hull.section_point(pm, zc, kPointEps * tol);
         if (iv.depth < 40 && static_cast<int>(sc.pts.size()) < kMaxPoints && sp + 2 <= 64 &&
             dist_to_line(m, iv.a, iv.b) > 0.5 * tol) {
           stack[sp++] = {pm, iv.pb, m, iv.b, iv.depth + 1};  // right half processed last
