@@ -11,6 +11,8 @@ PACKAGES=(
   libglfw3-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
+  # independent mesh checker for the exported STL (tests/cli_mesh_admesh.cmake)
+  admesh
   # libFuzzer decoder targets (tools/test.sh builds them with clang)
   clang
   # HIL bench (tools/hil/hil-bench.sh): VM with Debian's kernel, vcan, busybox initramfs

@@ -302,6 +302,32 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
         const Path& p = work[g.side][g.c];
         return {p[g.j], p[(g.j + 1) % p.size()]};
       };
+      // w is the vertex before the segment's start or after its end: inserting it would make
+      // the ring run w -> a -> w (or w -> b -> w), a zero-area spike whose two walls meet the
+      // edges beside them four times (a non-manifold edge; issue 13 item 6).
+      auto folds = [&](const Seg& g, const Point& w) {
+        const Path& p = work[g.side][g.c];
+        const std::size_t n = p.size();
+        return same(w, p[(g.j + n - 1) % n]) || same(w, p[(g.j + 2) % n]);
+      };
+      auto insert_ok = [&](const Seg& g, const Point& a, const Point& b, const Point& w) {
+        return may_insert(a, b, w) && !folds(g, w);
+      };
+      // w = ring[i] of the other level lies off the edge a->b (within the tolerance) and its
+      // edge to a ring neighbour lying on a->b runs the other way: the two levels' material is
+      // on opposite sides of that stretch. Snapping w onto a->b would make that edge one of
+      // both levels with opposite material, four faces on one edge (a ball contour grazing
+      // the stock face within 2 units in high.ngc). Clipper's cap follows w's own edge instead.
+      auto opposed = [&](const Seg& g, std::size_t i, const Point& a, const Point& b) {
+        const Path& ring = work[g.side][g.c];
+        const std::size_t n = ring.size();
+        const Point& w = ring[i % n];
+        if (orient(a, b, w) == 0) return false;  // exactly on the edge: always a split point
+        const Point& prev = ring[(i + n - 1) % n];
+        const Point& next = ring[(i + 1) % n];
+        auto on_ab = [&](const Point& x) { return same(x, a) || same(x, b) || near_inside(a, b, x); };
+        return (on_ab(prev) && along(a, b, w) < along(a, b, prev)) || (on_ab(next) && along(a, b, next) < along(a, b, w));
+      };
       bool any = false;
       if (round == 0)
         for (const Seg& g : segs)
@@ -320,7 +346,7 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
         for (const Point& w : feed)
           for (const Seg& g : segs) {
             const auto [a, b] = seg_pts(g);
-            if (may_insert(a, b, w)) {
+            if (insert_ok(g, a, b, w)) {
               splits[g.side][g.c][g.j].push_back(w);
               any = true;
             }
@@ -336,13 +362,15 @@ void Reconstructor::Cache::build_plane(const geom::LbrSolid& s, int r, int k, co
           const auto [q1, q2] = seg_pts(B);
           auto& sa = splits[A.side][A.c][A.j];
           auto& sb = splits[B.side][B.c][B.j];
-          bool touch = false;
-          if (may_insert(q1, q2, p1)) { sb.push_back(p1); touch = true; }
-          if (may_insert(q1, q2, p2)) { sb.push_back(p2); touch = true; }
-          if (may_insert(p1, p2, q1)) { sa.push_back(q1); touch = true; }
-          if (may_insert(p1, p2, q2)) { sa.push_back(q2); touch = true; }
-          if (touch) {
-            any = true;
+          const bool t1 = may_insert(q1, q2, p1), t2 = may_insert(q1, q2, p2);
+          const bool t3 = may_insert(p1, p2, q1), t4 = may_insert(p1, p2, q2);
+          const std::size_t before = sa.size() + sb.size();
+          if (t1 && !folds(B, p1) && !opposed(A, A.j, q1, q2)) sb.push_back(p1);
+          if (t2 && !folds(B, p2) && !opposed(A, A.j + 1, q1, q2)) sb.push_back(p2);
+          if (t3 && !folds(A, q1) && !opposed(B, B.j, p1, p2)) sa.push_back(q1);
+          if (t4 && !folds(A, q2) && !opposed(B, B.j + 1, p1, p2)) sa.push_back(q2);
+          if (t1 || t2 || t3 || t4) {  // touching, not crossing (a skipped point stays a touch)
+            any = any || sa.size() + sb.size() != before;
             continue;
           }
           const int d1 = orient(q1, q2, p1), d2 = orient(q1, q2, p2);
