@@ -262,5 +262,40 @@ TEST_F(GfxRender, RenderThreadRunsAtItsRateWhileCutsArrive) {
   RecordProperty("refused_publishes", std::to_string(refused));
 }
 
+// Issue 19 item 3: a groove along the front face y = 0 that stops at x = 72 (flat Ø10, so
+// material is cut up to x = 77) colours its own faces, while the uncut part of the front
+// face (x > 78) stays grey in heat mode, up to the corner at x = 100 where smoothed wall
+// normals turn towards the side face.
+TEST_F(GfxRender, HeatLeavesTheUncutPartOfACutSideFaceGrey) {
+  geom::LbrSolid s(box_spec({0, 0, -30}, {100, 80, 0}, 0.1, 4, 4));
+  const geom::CutterShape t10 = geom::CutterShape::build(tool(geom::ToolKind::Flat, 10.0), 0.002);
+  cut_path(s, t10, {{50, 40, 50}, {-6, 0, 5}, {-6, 0, -1}, {72, 0, -1}});
+  s.clear_dirty();
+  gfx::Renderer ren(s, test_options());
+  gfx::Camera cam;
+  cam.set_view(gfx::StandardView::Front);
+  cam.fit(ren.stock_box(), static_cast<double>(kW) / kH);
+  const gfx::Image img = ren.render_offscreen(cam, kW, kH, true, nullptr);
+  if (const char* dir = std::getenv("LBR_GFX_TEST_PNG_DIR")) gfx::write_png(std::string(dir) + "/groove_front.png", img);
+  int face_px = 0, face_hot = 0, groove_px = 0, groove_hot = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const auto w = world_at(cam, img, x, y);
+      if (!w) continue;
+      if (std::abs(w->y) < 0.05 && w->x > 78 && w->x < 99.8 && w->z > -0.95 && w->z < -0.05) {
+        ++face_px;
+        if (chroma(img.px(x, y)) > 16) ++face_hot;
+      }
+      if (std::abs(w->y - 5.0) < 0.05 && w->x > 5 && w->x < 70 && w->z > -0.95) {  // the groove's back wall
+        ++groove_px;
+        if (chroma(img.px(x, y)) > 40) ++groove_hot;
+      }
+    }
+  ASSERT_GT(face_px, 40);
+  EXPECT_EQ(face_hot, 0) << "of " << face_px << " pixels of the uncut front face at x 78..100";
+  ASSERT_GT(groove_px, 40);
+  EXPECT_GT(groove_hot, groove_px * 9 / 10);
+}
+
 }  // namespace
 }  // namespace lbr

@@ -104,13 +104,17 @@ vec3 heat(float t) {
   if (t < 3.0) return mix(c2, c3, t - 2.0);
   return mix(c3, c4, t - 3.0);
 }
-bool on_stock_face(vec3 p, vec3 n) {
+bool on_stock_face(vec3 p) {
   // Untouched stock faces lie on the stock box; heat colouring leaves them plain so that
-  // cut ids interpolated over big cap triangles do not bleed onto them.
+  // cut ids interpolated over big cap triangles do not bleed onto them. The test takes the
+  // triangle's own (flat) normal from the screen-space derivatives of the position: the
+  // smoothed vertex normals of walls turn towards the neighbouring face near a stock corner,
+  // and with them a band of an untouched side face lost its grey (issue 19).
+  vec3 g = normalize(cross(dFdx(p), dFdy(p)));
   float e = 1e-3 * max(1.0, length(u_stock_hi - u_stock_lo));
-  return (abs(p.z - u_stock_hi.z) < e && n.z > 0.9) || (abs(p.z - u_stock_lo.z) < e && n.z < -0.9) ||
-         (abs(p.x - u_stock_lo.x) < e && n.x < -0.9) || (abs(p.x - u_stock_hi.x) < e && n.x > 0.9) ||
-         (abs(p.y - u_stock_lo.y) < e && n.y < -0.9) || (abs(p.y - u_stock_hi.y) < e && n.y > 0.9);
+  return ((abs(p.z - u_stock_hi.z) < e || abs(p.z - u_stock_lo.z) < e) && abs(g.z) > 0.9) ||
+         ((abs(p.x - u_stock_lo.x) < e || abs(p.x - u_stock_hi.x) < e) && abs(g.x) > 0.9) ||
+         ((abs(p.y - u_stock_lo.y) < e || abs(p.y - u_stock_hi.y) < e) && abs(g.y) > 0.9);
 }
 void main() {
   if (u_mode == 4) { o_col = vec4(u_color, 1.0); return; }
@@ -119,7 +123,7 @@ void main() {
   if (dot(n, V) < 0.0) n = -n;
   vec3 base = u_color;
   if (u_mode == 1) {
-    base = (v_attr < 0.5 || on_stock_face(v_pos, n)) ? vec3(0.60, 0.61, 0.63) : heat(v_attr / max(u_max_attr, 1.0));
+    base = (v_attr < 0.5 || on_stock_face(v_pos)) ? vec3(0.60, 0.61, 0.63) : heat(v_attr / max(u_max_attr, 1.0));
   }
   vec3 L = normalize(u_key);
   vec3 F = normalize(vec3(-u_key.x, -u_key.y, 0.35));  // fill from the opposite side
