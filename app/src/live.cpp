@@ -56,6 +56,14 @@ std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   j["sweeps"] = r.sweeps;
   j["batches"] = r.batches;
   j["record_overruns"] = r.record_overruns;
+  j["samples_coalesced"] = r.samples_coalesced;
+  j["overflow_overruns"] = r.overflow_overruns;
+  j["overflow_high_water"] = r.overflow_high_water;
+  j["overflow_capacity"] = r.overflow_capacity;
+  j["kernel_calls"] = r.kernel_calls;
+  j["sweeps_split"] = r.sweeps_split;
+  j["samples_unapplied"] = r.samples_unapplied;
+  j["stop_latency_ms"] = r.stop_latency_ms;
   j["wall_time_s"] = r.wall_time_s;
   j["rt_mode"] = r.rt_mode;
   j["peak_rss_mb"] = peak_rss_mb();

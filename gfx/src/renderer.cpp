@@ -517,10 +517,12 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
       if (L.live)
         std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n),
                       "lag %.1f ms  samples %.0f Hz  ring hw %llu/%llu  overruns %llu  decode errors %llu\n"
+                      "behind: coalesced %llu  held %llu\n"
                       "%s\n",
                       L.lag_ms, L.sample_rate_hz, static_cast<unsigned long long>(L.ring_high_water),
                       static_cast<unsigned long long>(L.ring_capacity), static_cast<unsigned long long>(L.ring_overruns),
-                      static_cast<unsigned long long>(L.decode_errors), L.realtime ? "RT (SCHED_FIFO)" : "non-RT");
+                      static_cast<unsigned long long>(L.decode_errors), static_cast<unsigned long long>(L.samples_coalesced),
+                      static_cast<unsigned long long>(L.samples_held), L.realtime ? "RT (SCHED_FIFO)" : "non-RT");
       else
         std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "no live source (batch result)\n");
     }

@@ -36,13 +36,18 @@ struct LiveOptions {
   // `on_start` receives the solid before any thread starts (the render side's initial copy).
   gfx::SolidExchange* exchange = nullptr;
   std::function<void(const geom::LbrSolid&)> on_start;
+  // Overload (docs/architecture.md "Live overload"): samples the HAL side may hold while the
+  // ring is full (0: 16 × live.ring_capacity); testing: sleep this long after every kernel
+  // call (a deliberately slowed kernel).
+  std::size_t overflow_capacity = 0;
+  std::int64_t test_kernel_delay_ns = 0;
 };
 
 struct LiveResult {
   geom::LbrSolid solid;
   std::string source;
   std::uint64_t samples_received = 0;  // decoded samples handed over by the source
-  std::uint64_t samples_applied = 0;   // samples the geometry thread consumed
+  std::uint64_t samples_applied = 0;   // samples the geometry thread applied (coalesced ones included)
   std::uint64_t samples_lost = 0;      // sequence gaps + incomplete cycles + rejected + overruns
   std::uint64_t samples_rejected = 0;  // failed validation (out_of_range, jump)
   std::uint64_t ring_overruns = 0;
@@ -56,7 +61,15 @@ struct LiveResult {
   double stock_volume_mm3 = 0, removed_volume_mm3 = 0;
   double wall_time_s = 0;
   std::string rt_mode;  // "fifo" when both RT threads got SCHED_FIFO, else "non-rt"
-  double batch_p50_ms = 0, batch_p99_ms = 0, batch_max_ms = 0;  // subtract() per geometry tick
+  double batch_p50_ms = 0, batch_p99_ms = 0, batch_max_ms = 0;  // subtract() per kernel call (sub-batch)
+  // Overload (docs/protocols.md#counters): samples folded by the HAL side into a held one
+  // (exact, part of samples_applied), samples lost with ring and overflow full (part of
+  // samples_lost), the overflow's high water and capacity, kernel calls and sweeps cut into
+  // pieces by the work budget, samples a stop left unapplied, and how long the stop took
+  // (from the request being seen to the geometry thread's end) [ms].
+  std::uint64_t samples_coalesced = 0, overflow_overruns = 0, overflow_high_water = 0, overflow_capacity = 0;
+  std::uint64_t kernel_calls = 0, sweeps_split = 0, samples_unapplied = 0;
+  double stop_latency_ms = 0;
 };
 
 using StatusFn = std::function<void(const std::string& line)>;

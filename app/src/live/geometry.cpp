@@ -1,6 +1,7 @@
 #include "live/geometry.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "sched/rt_thread.hpp"
 
@@ -21,42 +22,222 @@ Geometry::Geometry(geom::LbrSolid& solid, const Profile& profile, const motion::
       stream_(tools, channel_kinematics(profile), default_tool, tol_mm,
               2 * ring.capacity() + hal::kMaxChannels + kin::kMaxMoveSubsteps, *this) {
   rx_.resize(ring.capacity());
+  weight_.resize(ring.capacity());
+  const std::size_t cells = static_cast<std::size_t>(solid.levels()) * static_cast<std::size_t>(solid.regions());
+  if (cells <= (std::size_t{1} << 22)) stamp_.assign(cells, 0);  // else: cells counted per sweep
+}
+
+namespace {
+
+// Work estimate weights [units]: building one section of one sweep on one level, and one
+// polygon difference of a (region, level) cell. Measured on this machine (docs/performance.md
+// "Live overload"): a unit is roughly a microsecond of kernel time.
+constexpr double kSectionUnits = 2.0;
+constexpr double kCellUnits = 20.0;
+constexpr int kMaxPieces = 64;  // one sweep is cut into at most this many pieces
+
+}  // namespace
+
+bool Geometry::reach(const geom::SweepRef& s, Reach& r) const noexcept {
+  const geom::LbrSolid& so = solid_;
+  double zlo = 0.0, zhi = 0.0, xlo = 0.0, xhi = 0.0, ylo = 0.0, yhi = 0.0;
+  bool whole_grid = false;
+  r.tilt = 1.0;
+  if (s.shape != nullptr) {
+    const double rad = s.shape->radius(), h = s.shape->height();
+    const geom::Vec3 p[4] = {s.from.tip, s.to.tip, s.from.tip + h * s.from.axis, s.to.tip + h * s.to.axis};
+    zlo = zhi = p[0].z;
+    xlo = xhi = p[0].x;
+    ylo = yhi = p[0].y;
+    for (const geom::Vec3& v : p) {
+      zlo = std::min(zlo, v.z), zhi = std::max(zhi, v.z);
+      xlo = std::min(xlo, v.x), xhi = std::max(xhi, v.x);
+      ylo = std::min(ylo, v.y), yhi = std::max(yhi, v.y);
+    }
+    zlo -= rad, zhi += rad, xlo -= rad, xhi += rad, ylo -= rad, yhi += rad;
+    // A turning tool axis: geom::Sweep cuts it into sub-steps within the chord tolerance;
+    // a point h from the tip turning by θ needs about θ·sqrt(h / (8·tol)) of them.
+    const double c = std::clamp(geom::dot(s.from.axis, s.to.axis), -1.0, 1.0);
+    const double theta = std::acos(c);
+    if (theta > 0.0)
+      r.tilt = 1.0 + std::min(256.0, theta * std::sqrt(h / (8.0 * std::max(1e-6, s.shape->chord_tol_mm))));
+  } else if (s.turning != nullptr) {
+    const double e = s.turning->z_extent;
+    zlo = std::min(s.from.tip.z, s.to.tip.z) - e;
+    zhi = std::max(s.from.tip.z, s.to.tip.z) + e;
+    whole_grid = true;  // revolved about the spindle axis
+  } else {
+    return false;
+  }
+  if (zhi < so.z_bottom_mm() || zlo > so.z_top_mm()) return false;
+  r.l0 = so.level_at(zlo);
+  r.l1 = so.level_at(zhi);
+  const geom::Rect st = so.stock_rect();
+  const double x0 = geom::to_mm(st.x0), y0 = geom::to_mm(st.y0);
+  const double wx = (geom::to_mm(st.x1) - x0) / so.regions_x(), wy = (geom::to_mm(st.y1) - y0) / so.regions_y();
+  auto cell = [](double v, double lo, double w, int n) {
+    return std::clamp(static_cast<int>(std::floor((v - lo) / w)), 0, n - 1);
+  };
+  if (whole_grid) {
+    r.x0 = 0, r.x1 = so.regions_x() - 1, r.y0 = 0, r.y1 = so.regions_y() - 1;
+  } else {
+    if (xhi < x0 || ylo > geom::to_mm(st.y1) || xlo > geom::to_mm(st.x1) || yhi < y0) return false;
+    r.x0 = cell(xlo, x0, wx, so.regions_x()), r.x1 = cell(xhi, x0, wx, so.regions_x());
+    r.y0 = cell(ylo, y0, wy, so.regions_y()), r.y1 = cell(yhi, y0, wy, so.regions_y());
+  }
+  return true;
+}
+
+double Geometry::work_units(const geom::SweepRef& s) const noexcept {
+  Reach r;
+  if (!reach(s, r)) return 1.0;
+  const double levels = r.l1 - r.l0 + 1, cells = levels * (r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1);
+  return kSectionUnits * levels * r.tilt + kCellUnits * cells;
+}
+
+bool Geometry::stop_due() noexcept {
+  if (stop_ns_ == nullptr) return false;
+  std::int64_t t = stop_ns_->load(std::memory_order_relaxed);
+  const std::int64_t now = sched::now_ns();
+  if (t == 0) {
+    const bool asked = (stop_a_ != nullptr && stop_a_->load(std::memory_order_relaxed)) ||
+                       (stop_b_ != nullptr && stop_b_->load(std::memory_order_relaxed));
+    if (!asked) return false;
+    std::int64_t expected = 0;
+    (void)stop_ns_->compare_exchange_strong(expected, now, std::memory_order_relaxed);
+    t = stop_ns_->load(std::memory_order_relaxed);
+  }
+  return now - t >= stop_grace_ns_;
+}
+
+void Geometry::kernel(std::span<const geom::SweepRef> part) noexcept {
+  const std::int64_t t_start = sched::now_ns();
+  solid_.subtract(part, ws_);
+  work_.record(sched::now_ns() - t_start);
+  calls_.store(calls_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  sweeps_.store(sweeps_.load(std::memory_order_relaxed) + part.size(), std::memory_order_relaxed);
+  if (kernel_delay_ns_ > 0) sched::sleep_until_ns(sched::now_ns() + kernel_delay_ns_);
+}
+
+bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
+  std::size_t i = 0;
+  while (i < batch.size()) {
+    if (stop_due()) return false;
+    // The longest prefix within the budget: sections per sweep, cells once per sub-batch.
+    if (++stamp_gen_ == 0) {
+      std::fill(stamp_.begin(), stamp_.end(), 0U);
+      stamp_gen_ = 1;
+    }
+    double units = 0.0, first = 0.0;
+    std::size_t j = i;
+    for (; j < batch.size(); ++j) {
+      Reach r;
+      double u = 1.0;
+      if (reach(batch[j], r)) {
+        const double levels = r.l1 - r.l0 + 1;
+        double cells = 0.0;
+        if (stamp_.empty()) {
+          cells = levels * (r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1);
+        } else {
+          const auto regions_x = static_cast<std::size_t>(solid_.regions_x());
+          const auto nl = static_cast<std::size_t>(solid_.levels());
+          for (int y = r.y0; y <= r.y1; ++y)
+            for (int x = r.x0; x <= r.x1; ++x) {
+              const std::size_t base = (static_cast<std::size_t>(y) * regions_x + static_cast<std::size_t>(x)) * nl;
+              for (int l = r.l0; l <= r.l1; ++l) {
+                std::uint32_t& st = stamp_[base + static_cast<std::size_t>(l)];
+                if (st != stamp_gen_) st = stamp_gen_, cells += 1.0;
+              }
+            }
+        }
+        u = kSectionUnits * levels * r.tilt + kCellUnits * cells;
+      }
+      if (j > i && units + u > budget_) break;
+      units += u;
+      if (j == i) first = u;
+    }
+    if (j == i + 1 && first > budget_) {
+      // One sweep over the budget: pieces at geom::Sweep's own interpolated poses.
+      const geom::SweepRef& s = batch[i];
+      const int k = std::min(kMaxPieces, static_cast<int>(std::ceil(first / budget_)));
+      split_.store(split_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      geom::SweepRef piece = s;
+      for (int p = 1; p <= k; ++p) {
+        if (p > 1 && stop_due()) return false;
+        const double t = static_cast<double>(p) / k;
+        piece.from = piece.to;
+        if (p == 1) piece.from = s.from;
+        if (p == k) {
+          piece.to = s.to;
+        } else {
+          piece.to.tip = geom::lerp(s.from.tip, s.to.tip, t);
+          const geom::Vec3 a = geom::lerp(s.from.axis, s.to.axis, t);
+          const double n = geom::norm(a);
+          piece.to.axis = n > 0.0 ? (1.0 / n) * a : s.from.axis;
+        }
+        kernel(std::span<const geom::SweepRef>(&piece, 1));
+      }
+    } else {
+      kernel(batch.subspan(i, j - i));
+    }
+    i = j;
+  }
+  return true;
 }
 
 std::size_t Geometry::tick(std::size_t limit) {
   stream_.clear_batch();
+  abandoned_ = false;
   std::size_t n = 0;
   limit = std::min(limit, rx_.size());
   while (n < limit) {
     hal::AxisSample* s = ring_.front();
     if (s == nullptr) break;
     stream_.take(s->channel, s->seq, s->tool, s->q, s->mask);
-    rx_[n++] = s->t_rx_ns;
+    rx_[n] = s->t_rx_ns;
+    weight_[n++] = 1 + s->coalesced;
     ring_.pop();
   }
   stream_.flush_all();
-  if (!stream_.batch().empty()) {
-    const std::int64_t t_start = sched::now_ns();
-    solid_.subtract(stream_.batch(), ws_);
-    work_.record(sched::now_ns() - t_start);
-    sweeps_.store(sweeps_.load(std::memory_order_relaxed) + stream_.batch().size(), std::memory_order_relaxed);
-    batches_.store(batches_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  if (!abandoned_ && !stream_.batch().empty()) {
+    if (apply(stream_.batch())) batches_.store(batches_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    else abandoned_ = true;
   }
   if (n > 0) {
+    std::uint64_t samples = 0;
+    for (std::size_t i = 0; i < n; ++i) samples += weight_[i];
+    if (abandoned_) {  // a stop cut the batch short: these samples are not (all) in the solid
+      unapplied_.store(unapplied_.load(std::memory_order_relaxed) + samples, std::memory_order_relaxed);
+      return n;
+    }
     last_rx_ns_ = rx_[n - 1];
     const std::int64_t t = sched::now_ns();
-    for (std::size_t i = 0; i < n; ++i) lag_.record(t - rx_[i]);
-    applied_.store(applied_.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::uint32_t w = 0; w < weight_[i]; ++w) lag_.record(t - rx_[i]);
+    applied_.store(applied_.load(std::memory_order_relaxed) + samples, std::memory_order_relaxed);
+    coalesced_.store(coalesced_.load(std::memory_order_relaxed) + samples - n, std::memory_order_relaxed);
     if (++ticks_since_volume_ >= 50) publish_volume();
   }
   return n;
+}
+
+std::uint64_t Geometry::discard() noexcept {
+  std::uint64_t samples = 0;
+  while (hal::AxisSample* s = ring_.front()) {
+    samples += 1 + s->coalesced;
+    ring_.pop();
+  }
+  unapplied_.store(unapplied_.load(std::memory_order_relaxed) + samples, std::memory_order_relaxed);
+  return samples;
 }
 
 void Geometry::on_sweep(const geom::SweepRef& s) noexcept {
   if (ex_ != nullptr) ex_->add_path_point(s.to.tip);
 }
 
-void Geometry::on_batch_full(std::span<const geom::SweepRef> batch) noexcept { solid_.subtract(batch, ws_); }
+void Geometry::on_batch_full(std::span<const geom::SweepRef> batch) noexcept {
+  if (!abandoned_ && !apply(batch)) abandoned_ = true;
+}
 
 bool Geometry::publish(const gfx::LiveStats& stats) {
   if (ex_ == nullptr) return false;

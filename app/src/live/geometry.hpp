@@ -3,6 +3,14 @@
 // of straight runs per channel), subtract them, record lag and batch work, publish to the
 // render side.
 //
+// Bounded work (issue 13 item 4b): the batch is subtracted in sub-batches whose estimated
+// work (work_units(): the (level, region) cells the sweeps reach and the sections they
+// need, a tool-axis turn counting as many sections) stays within a budget, and a single
+// sweep over the budget is cut into pieces at poses interpolated as geom::Sweep does (tip
+// linear, axis normalised-linear). The split depends only on the sweeps, so a non-live
+// run stays reproducible. Between kernel calls the geometry thread looks at the stop
+// request: once stop_grace_ns has passed since it was made, the rest is abandoned.
+//
 // Real-time contract (tests/app_live_alloc_test.cpp measures it): draining the ring and the
 // motion stream never allocate; LbrSolid::subtract() allocates inside Clipper (bounded by
 // the batch: the cells its sweeps touch), and publish() copies cells into the exchange's
@@ -13,6 +21,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "app/profile.hpp"
@@ -33,8 +42,31 @@ class Geometry final : public motion::SweepSink {
   Geometry(geom::LbrSolid& solid, const Profile& profile, const motion::ToolTable& tools, int default_tool,
            sched::SpscRing<hal::AxisSample>& ring, double tol_mm);
 
-  // Applies what is in the ring, at most `limit` samples; returns the samples applied.
+  // Applies what is in the ring, at most `limit` ring entries; returns the entries taken.
   std::size_t tick(std::size_t limit);
+
+  // Stop handling: `a` or `b` set asks for a stop; the first kernel-call boundary that sees
+  // it stores the time in `*stop_ns` (unless another thread did), and from stop_ns + grace
+  // on, tick() abandons what it has not applied (abandoned() says so). Setup.
+  void set_stop(const std::atomic<bool>* a, const std::atomic<bool>* b, std::atomic<std::int64_t>* stop_ns,
+                std::int64_t grace_ns) noexcept {
+    stop_a_ = a;
+    stop_b_ = b;
+    stop_ns_ = stop_ns;
+    stop_grace_ns_ = grace_ns;
+  }
+  // True once the stop's grace time has passed (checked at kernel-call boundaries).
+  [[nodiscard]] bool stop_due() noexcept;
+  [[nodiscard]] bool abandoned() const noexcept { return abandoned_; }
+  // Empties the ring without applying (after a stop); counts them in unapplied().
+  std::uint64_t discard() noexcept;
+  // Work budget of one kernel call [units of work_units()].
+  void set_work_budget(double units) noexcept { budget_ = units; }
+  [[nodiscard]] double work_budget() const noexcept { return budget_; }
+  // Testing: sleep this long after every kernel call (a deliberately slowed kernel).
+  void set_kernel_delay_ns(std::int64_t ns) noexcept { kernel_delay_ns_ = ns; }
+  // Estimated work of one sweep alone (cells it reaches + its sections).
+  [[nodiscard]] double work_units(const geom::SweepRef& s) const noexcept;
 
   // Rendering: tip points go to the exchange's path buffer (no allocation).
   void set_exchange(gfx::SolidExchange* ex) noexcept { ex_ = ex; }
@@ -47,9 +79,16 @@ class Geometry final : public motion::SweepSink {
   [[nodiscard]] std::uint64_t applied() const noexcept { return applied_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t sweeps() const noexcept { return sweeps_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t batches() const noexcept { return batches_.load(std::memory_order_relaxed); }
+  // Samples applied that the HAL side had folded into others (part of applied()).
+  [[nodiscard]] std::uint64_t coalesced() const noexcept { return coalesced_.load(std::memory_order_relaxed); }
+  // Kernel calls (sub-batches) and sweeps cut into pieces by the work budget.
+  [[nodiscard]] std::uint64_t kernel_calls() const noexcept { return calls_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t sweeps_split() const noexcept { return split_.load(std::memory_order_relaxed); }
+  // Samples taken from the ring but abandoned by a stop (not counted as applied).
+  [[nodiscard]] std::uint64_t unapplied() const noexcept { return unapplied_.load(std::memory_order_relaxed); }
   [[nodiscard]] double removed_mm3() const noexcept { return removed_.load(std::memory_order_relaxed); }
   [[nodiscard]] const sched::LatencyHistogram& lag() const noexcept { return lag_; }
-  // Duration of each tick's subtract() (the geometry thread's work per batch).
+  // Duration of each kernel call (subtract() of one sub-batch).
   [[nodiscard]] const sched::LatencyHistogram& work() const noexcept { return work_; }
 
   // motion::SweepSink
@@ -58,14 +97,33 @@ class Geometry final : public motion::SweepSink {
 
  private:
   static std::array<kin::Kinematics, motion::kMaxChannels> channel_kinematics(const Profile& profile);
+  // Subtracts `batch` in sub-batches within the work budget; false when a stop cut it short.
+  bool apply(std::span<const geom::SweepRef> batch) noexcept;
+  void kernel(std::span<const geom::SweepRef> part) noexcept;
+  // Cells of one sweep [levels l0..l1] x [regions x0..x1, y0..y1]; false when it reaches none.
+  struct Reach {
+    int l0 = 0, l1 = -1, x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+    double tilt = 1.0;  // sections per level (a turning tool axis needs several)
+  };
+  [[nodiscard]] bool reach(const geom::SweepRef& s, Reach& r) const noexcept;
 
   geom::LbrSolid& solid_;
   sched::SpscRing<hal::AxisSample>& ring_;
   motion::SampleStream stream_;
   geom::SubtractWorkspace ws_;
   std::vector<std::int64_t> rx_;
+  std::vector<std::uint32_t> weight_;      // 1 + samples folded into ring entry i
+  std::vector<std::uint32_t> stamp_;       // per (region, level): sub-batch that counted it
+  std::uint32_t stamp_gen_ = 0;
+  double budget_ = 60'000.0;
+  std::int64_t kernel_delay_ns_ = 0;
+  const std::atomic<bool>* stop_a_ = nullptr;
+  const std::atomic<bool>* stop_b_ = nullptr;
+  std::atomic<std::int64_t>* stop_ns_ = nullptr;
+  std::int64_t stop_grace_ns_ = 0;
+  bool abandoned_ = false;
   sched::LatencyHistogram lag_, work_;
-  std::atomic<std::uint64_t> applied_{0}, sweeps_{0}, batches_{0};
+  std::atomic<std::uint64_t> applied_{0}, sweeps_{0}, batches_{0}, coalesced_{0}, calls_{0}, split_{0}, unapplied_{0};
   std::atomic<double> removed_{0.0};
   int ticks_since_volume_ = 0;
   gfx::SolidExchange* ex_ = nullptr;

@@ -47,6 +47,10 @@ struct LivePipeline::Impl {
   std::atomic<bool> hal_done{false}, geo_running{false};
   std::atomic<int> hal_mode{-1}, geo_mode{-1};
   std::atomic<std::uint64_t> source_lost{0};
+  // Stop: when a thread first saw the request (0: not yet), when the geometry thread ended,
+  // and the held samples the HAL side still had then.
+  std::atomic<std::int64_t> stop_ns{0}, geo_end_ns{0};
+  std::atomic<std::uint64_t> hal_abandoned{0};
   std::int64_t t0 = 0;
   std::thread hal, geometry, recorder;
   bool stopped = false;
@@ -87,6 +91,8 @@ gfx::LiveStats live_stats(const LivePipeline::Impl& p) {
   st.ring_capacity = p.ring->capacity();
   st.ring_overruns = p.ring->overruns();
   st.decode_errors = p.src->counters().total() + p.sink->counters().total();
+  st.samples_coalesced = p.sink->coalesced();
+  st.samples_held = p.sink->held();
   st.realtime = p.hal_mode.load(std::memory_order_relaxed) == 1 && p.geo_mode.load(std::memory_order_relaxed) == 1;
   return st;
 }
@@ -102,6 +108,12 @@ gfx::LiveStats live_stats(const LivePipeline::Impl& p) {
 // (sched_rt_runtime_us, by default 950 ms per second), which then stops it for the rest of
 // the second: measured 50–56 ms stalls and a lag p99 of 31 ms on the "high" workload at
 // 1 kHz without this limit.
+//
+// Stop (docs/architecture.md "Live overload"): after a stop request the thread goes on
+// applying what is queued for kStopGraceNs, then abandons the rest (counted as
+// samples_unapplied) — checked between kernel calls, whose work the budget bounds.
+constexpr std::int64_t kStopGraceNs = 250'000'000;
+
 void geometry_thread(LivePipeline::Impl& p) {
   const hal::LiveConfig& cfg = p.profile.live;
   p.geo_mode = sched::configure_current_thread(cfg.geometry_thread) == sched::RtMode::Fifo ? 1 : 0;
@@ -111,7 +123,9 @@ void geometry_thread(LivePipeline::Impl& p) {
   for (;;) {
     const bool finished = p.hal_done.load(std::memory_order_acquire);
     const std::int64_t t_tick = sched::now_ns();
+    if (p.geo->stop_due()) break;
     if ((finished || !p.backpressure || p.ring->size() >= chunk) && p.geo->tick(chunk) > 0) {
+      if (p.geo->abandoned()) break;
       if (p.opt.exchange != nullptr) (void)p.geo->publish(live_stats(p));
       if (rest_per_work > 0.0 && !finished) {
         const std::int64_t now = sched::now_ns();
@@ -122,22 +136,39 @@ void geometry_thread(LivePipeline::Impl& p) {
     if (finished && p.ring->front() == nullptr) break;
     sched::sleep_until_ns(sched::now_ns() + idle_ns);
   }
-  // The final state must reach the render side: retry while it is busy (bounded: 2 s).
-  for (int i = 0; p.opt.exchange != nullptr && i < 1000 && !p.geo->publish(live_stats(p)); ++i)
+  const bool stopping = p.stop_ns.load(std::memory_order_relaxed) != 0;
+  if (stopping) (void)p.geo->discard();
+  // The final state must reach the render side: retry while it is busy (bounded: 2 s, or
+  // 0.2 s after a stop).
+  for (int i = 0; p.opt.exchange != nullptr && i < (stopping ? 100 : 1000) && !p.geo->publish(live_stats(p)); ++i)
     sched::sleep_until_ns(sched::now_ns() + 2'000'000);
+  p.geo_end_ns.store(sched::now_ns(), std::memory_order_relaxed);
   p.geo->publish_volume();
   p.geo_running.store(false, std::memory_order_release);
 }
 
-// HAL thread: polls the source until it ends or a stop is asked for.
+bool stop_asked(const LivePipeline::Impl& p) noexcept {
+  return p.external_stop.load(std::memory_order_relaxed) || p.stop_requested.load(std::memory_order_relaxed);
+}
+
+// HAL thread: polls the source until it ends or a stop is asked for; between polls, held
+// samples (the geometry thread behind) move into the ring as it empties. When the source
+// ends, it waits for the held ones to go in, unless a stop is asked for.
 void hal_thread(LivePipeline::Impl& p) {
   p.hal_mode = sched::configure_current_thread(p.profile.live.hal_thread) == sched::RtMode::Fifo ? 1 : 0;
-  while (!p.external_stop.load(std::memory_order_relaxed) && !p.stop_requested.load(std::memory_order_relaxed)) {
+  while (!stop_asked(p)) {
     const hal::PollResult pr = p.src->poll(50, *p.sink);
     p.source_lost.store(p.src->lost(), std::memory_order_relaxed);  // the source is this thread's
+    (void)p.sink->pump();
     if (pr == hal::PollResult::End) break;
     if (pr == hal::PollResult::Error) sched::sleep_until_ns(sched::now_ns() + 1'000'000);  // no busy loop
   }
+  while (!p.sink->pump() && !stop_asked(p)) sched::sleep_until_ns(sched::now_ns() + 1'000'000);
+  if (stop_asked(p)) {
+    std::int64_t expected = 0;
+    (void)p.stop_ns.compare_exchange_strong(expected, sched::now_ns(), std::memory_order_relaxed);
+  }
+  p.hal_abandoned.store(p.sink->abandon(), std::memory_order_relaxed);
   p.hal_done.store(true, std::memory_order_release);
 }
 
@@ -165,7 +196,14 @@ void snapshot(LivePipeline::Impl& p) {
   r.samples_rejected = p.sink->rejected();
   r.ring_overruns = p.ring->overruns();
   r.ring_high_water = p.ring->high_water();
-  r.samples_lost = p.source_lost.load(std::memory_order_relaxed) + r.samples_rejected + r.ring_overruns;
+  r.samples_coalesced = p.sink->coalesced();
+  r.overflow_overruns = p.sink->overflow_overruns();
+  r.overflow_high_water = p.sink->overflow_high_water();
+  r.overflow_capacity = p.sink->overflow_capacity();
+  r.kernel_calls = p.geo->kernel_calls();
+  r.sweeps_split = p.geo->sweeps_split();
+  r.samples_unapplied = p.geo->unapplied() + p.hal_abandoned.load(std::memory_order_relaxed);
+  r.samples_lost = p.source_lost.load(std::memory_order_relaxed) + r.samples_rejected + r.ring_overruns + r.overflow_overruns;
   const auto ms = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-6; };
   const sched::LatencyHistogram& lag = p.geo->lag();
   r.lag_p50_ms = ms(lag.percentile_ns(0.5));
@@ -215,8 +253,11 @@ void LivePipeline::configure() {
     p.src->set_recording(true);
   }
   if (p.opt.source.rfind("can:", 0) == 0) p.rec_iface = p.opt.source.substr(4);
-  p.sink = std::make_unique<RingSink>(*p.ring, p.rec_ring.get(), cfg, p.backpressure, p.stop_requested);
+  p.sink = std::make_unique<RingSink>(*p.ring, p.rec_ring.get(), cfg, p.backpressure, p.stop_requested,
+                                      p.opt.overflow_capacity);
   p.geo = std::make_unique<Geometry>(p.r->solid, profile, *p.tools, cfg.tool, *p.ring, cfg.merge_tolerance_mm);
+  p.geo->set_stop(&p.external_stop, &p.stop_requested, &p.stop_ns, kStopGraceNs);
+  p.geo->set_kernel_delay_ns(p.opt.test_kernel_delay_ns);
   p.geo->set_exchange(p.opt.exchange);
   if (p.opt.on_start) p.opt.on_start(p.r->solid);
   p.r->solid.clear_dirty();  // the render side starts from this state
@@ -238,12 +279,13 @@ std::string LivePipeline::status_line() {
   Impl& p = *impl_;
   snapshot(p);
   const LiveResult& r = *p.r;
-  char line[320];
+  char line[400];
   std::snprintf(line, sizeof line,
                 "t %.1f s | rx %" PRIu64 " applied %" PRIu64 " lost %" PRIu64 " | ring hw %" PRIu64 "/%zu overruns %" PRIu64
-                " | lag p50 %.2f p99 %.2f max %.2f ms | removed %.1f mm3 | errors %" PRIu64,
+                " | coalesced %" PRIu64 " held %" PRIu64 " | lag p50 %.2f p99 %.2f max %.2f ms | removed %.1f mm3 | errors %" PRIu64,
                 static_cast<double>(sched::now_ns() - p.t0) * 1e-9, r.samples_received, r.samples_applied, r.samples_lost,
-                r.ring_high_water, p.ring->capacity(), r.ring_overruns, r.lag_p50_ms, r.lag_p99_ms, r.lag_max_ms,
+                r.ring_high_water, p.ring->capacity(), r.ring_overruns, r.samples_coalesced, p.sink->held(), r.lag_p50_ms,
+                r.lag_p99_ms, r.lag_max_ms,
                 r.removed_volume_mm3, p.src->counters().total() + p.sink->counters().total());
   return line;
 }
@@ -269,12 +311,15 @@ LiveResult LivePipeline::result() {
   LiveResult& r = *p.r;
   r.wall_time_s = static_cast<double>(sched::now_ns() - p.t0) * 1e-9;
   p.geo->publish_volume();
+  (void)p.geo->discard();  // what the HAL thread pushed after the geometry thread ended (a stop)
   snapshot(p);
   r.removed_volume_mm3 = r.stock_volume_mm3 - r.solid.volume_mm3();
   r.ring_capacity = p.ring->capacity();
   r.sweeps = p.geo->sweeps();
   r.batches = p.geo->batches();
   r.record_overruns = p.sink->rec_overruns();
+  const std::int64_t t_stop = p.stop_ns.load(), t_end = p.geo_end_ns.load();
+  r.stop_latency_ms = t_stop > 0 && t_end > t_stop ? static_cast<double>(t_end - t_stop) * 1e-6 : 0.0;
   for (int k = 0; k < hal::kFaultKinds; ++k) {
     const auto f = static_cast<hal::Fault>(k);
     r.decode_errors[hal::fault_name(f)] = p.src->counters().get(f) + p.sink->counters().get(f);

@@ -47,6 +47,8 @@ struct LiveStats {
   std::uint64_t samples = 0;
   std::uint64_t ring_high_water = 0, ring_capacity = 0, ring_overruns = 0;
   std::uint64_t decode_errors = 0;
+  std::uint64_t samples_coalesced = 0;  // folded into others while behind (exact; none lost)
+  std::uint64_t samples_held = 0;       // waiting on the HAL side for room in the ring
   bool realtime = false;         // SCHED_FIFO granted to the HAL/geometry threads
   bool live = false;             // false: batch result or replay without live counters
 };

@@ -19,6 +19,10 @@ struct AxisSample {
   std::uint8_t channel = 0;
   std::uint8_t mask = 0;         // bit a set: q[a] holds a value
   std::int16_t tool = -1;        // tool in the spindle when the source knows it (emulator); -1: not reported
+  // Samples folded into this one by the HAL side when the geometry thread was behind
+  // (app/src/live/ring_sink.hpp: exact coalescing of collinear samples); 0 normally.
+  // t_rx_ns is then the receive time of the oldest of them.
+  std::uint32_t coalesced = 0;
   std::array<double, kMaxAxes> q{};  // X Y Z [mm], A B C [deg]
 };
 
