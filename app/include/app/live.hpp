@@ -41,6 +41,7 @@ struct LiveOptions {
   // call (a deliberately slowed kernel).
   std::size_t overflow_capacity = 0;
   std::int64_t test_kernel_delay_ns = 0;
+  double test_work_budget = 0;  // testing: work budget of one kernel call (0: the default)
 };
 
 struct LiveResult {

@@ -258,6 +258,7 @@ void LivePipeline::configure() {
   p.geo = std::make_unique<Geometry>(p.r->solid, profile, *p.tools, cfg.tool, *p.ring, cfg.merge_tolerance_mm);
   p.geo->set_stop(&p.external_stop, &p.stop_requested, &p.stop_ns, kStopGraceNs);
   p.geo->set_kernel_delay_ns(p.opt.test_kernel_delay_ns);
+  if (p.opt.test_work_budget > 0) p.geo->set_work_budget(p.opt.test_work_budget);
   p.geo->set_exchange(p.opt.exchange);
   if (p.opt.on_start) p.opt.on_start(p.r->solid);
   p.r->solid.clear_dirty();  // the render side starts from this state
