@@ -5,7 +5,10 @@
 //    nothing after start-up; a tick whose sweeps miss the stock allocates nothing either;
 //    a warmed-up tick that cuts allocates inside LbrSolid::subtract() (Clipper's polygon
 //    buffers and the result polygons of every cell it changes) — the count is measured here
-//    and bounded by the cells the batch changes, as docs/architecture.md states.
+//    and bounded by the cells the batch changes, as docs/architecture.md states;
+//  - overload: holding samples in the HAL side's overflow, folding collinear ones and
+//    pumping them into the ring, and the geometry thread's sub-batches and split sweeps,
+//    allocate nothing.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -103,6 +106,39 @@ TEST(LiveRealTime, SerialDecodeValidateAndRingDoNotAllocate) {
   EXPECT_EQ(counters.total(), 0u);
 }
 
+TEST(LiveRealTime, OverloadHoldAndFoldDoNotAllocate) {
+  // The geometry thread is behind (nobody pops a tiny ring): samples go to the overflow,
+  // collinear ones fold, corners stay; then the ring drains and pump() moves them in.
+  const app::Profile profile = app::default_profile();
+  hal::LiveConfig cfg = profile.live;
+  sched::SpscRing<hal::AxisSample> ring(8);
+  const std::atomic<bool> stop{false};
+  app::live::RingSink sink(ring, nullptr, cfg, false, stop, 4096);
+  auto feed = [&](std::uint64_t from, std::uint64_t to) {
+    for (std::uint64_t i = from; i < to; ++i) {
+      const double x = 10.0 + 0.01 * static_cast<double>(i % 500), y = static_cast<double>((i / 500) % 2);
+      hal::AxisSample s = sample(i, x, y, -1.0);
+      sink.on_samples(std::span<const hal::AxisSample>(&s, 1));
+    }
+  };
+  feed(0, 100);
+  const long before = allocations();
+  feed(100, 3000);
+  std::uint64_t popped = 0, weight = 0;
+  for (int round = 0; round < 10000 && !(sink.pump() && ring.front() == nullptr); ++round)
+    while (hal::AxisSample* s = ring.front()) {
+      ++popped;
+      weight += 1 + s->coalesced;
+      ring.pop();
+    }
+  EXPECT_EQ(allocations() - before, 0) << "holding, folding or pumping allocated";
+  EXPECT_EQ(sink.overflow_overruns(), 0u);
+  EXPECT_EQ(ring.overruns(), 0u);
+  EXPECT_GT(sink.coalesced(), 2000u);
+  EXPECT_EQ(weight, 3000u) << "every sample reaches the ring, alone or folded";
+  EXPECT_LT(popped, 100u);
+}
+
 class NullSink final : public motion::SweepSink {
  public:
   void on_sweep(const geom::SweepRef&) noexcept override { ++sweeps; }
@@ -162,6 +198,18 @@ TEST(LiveRealTime, GeometryTickInTheAirDoesNotAllocate) {
   const std::size_t applied = rig.pass(22.0, 5.0, 200);
   EXPECT_EQ(allocations() - before, 0) << "a tick whose sweeps miss the stock allocated";
   EXPECT_EQ(applied, 200u);
+}
+
+TEST(LiveRealTime, SplitBatchesInTheAirDoNotAllocate) {
+  // A tiny work budget: every sweep its own kernel call, each cut into pieces.
+  GeometryRig rig;
+  rig.geo->set_work_budget(1.0);
+  (void)rig.pass(20.0, 5.0, 200);
+  const long before = allocations();
+  const std::size_t applied = rig.pass(22.0, 5.0, 200);
+  EXPECT_EQ(allocations() - before, 0) << "sub-batching or splitting allocated";
+  EXPECT_EQ(applied, 200u);
+  EXPECT_GT(rig.geo->sweeps_split(), 0u);
 }
 
 TEST(LiveRealTime, CuttingTickAllocatesOnlyInsideTheKernel) {
