@@ -26,33 +26,55 @@ struct Walker {
       if (k == e) break;
     }
   }
-  // From vertex a to vertex b of the shared disk: along the disk when a lies on the cap
-  // interval [lo, hi] of the other move (the outer side of the turn), else through the
-  // centre (the inner side). `direct`: the inner side may take the chord a-b instead.
-  void join(P2 c, double rho, int a, int b, int lo, int hi, bool direct) {
+  // At the disk shared by moves p (ending there) and q (starting there), from vertex a to
+  // vertex b: along the disk when a lies on the cap interval [lo, hi] of the other move (the
+  // outer side of the turn), else on the inner side through the centre, or by the chord a-b
+  // when chord_is_covered().
+  void join(const MoveCaps& p, const MoveCaps& q, bool right) {
+    const P2 c = p.c1;
+    const double rho = p.rho1;
+    const int a = right ? p.front_r : q.back_l, b = right ? q.back_r : p.front_l;
+    const int lo = right ? q.back_l : p.front_r, hi = right ? q.back_r : p.front_l;
     if (on_arc(a, lo, hi, n)) {
       arc(c, rho, a, b);
       return;
     }
     vertex(c, rho, a);
-    if (!direct || !chord_is_covered(rho, (a - b + n) % n)) buf.push_back(c);
+    if (!chord_is_covered(p, q, right)) buf.push_back(c);
     vertex(c, rho, b);
   }
-  // The inner side of a join between two stadiums (moves k and k+1 at the shared disk,
-  // centre c, turning by `steps` grid steps, α): the path through c and the chord a-b
-  // differ by the triangle (c, b, a) inside the shared disk. The triangle lies in both
-  // stadiums and outside the four caps that the outline replaces by spokes when
-  // ρ·sin α < L·cos(2π/n) for both move lengths L: the spoke of a move's far cap has the
-  // direction of the near spoke, and the line through the far centre along it separates
-  // the far cap from the triangle (docs/lbr-conventions.md, "Joined sections"). The
-  // triangle is then covered twice and the chord leaves it covered once. A spoke to c
-  // crosses every neighbouring side within ρ of it; the chord crosses none.
-  double shorter = 0.0;  // the shorter of the two moves at this join [mm]
-  bool chord_is_covered(double rho, int steps) const {
-    const double step = 2.0 * std::numbers::pi / n;
-    const double alpha = steps * step;
-    if (alpha >= 0.25 * std::numbers::pi) return false;
-    return rho * std::sin(alpha) < 0.9 * std::cos(step) * shorter;
+  // The inner side of a join: the path through the centre c and the chord a-b differ by the
+  // triangle T = (c, b, a) inside the shared disk, which both sections contain. The outline
+  // is the sum of the sections with their caps replaced by spokes (docs/lbr-conventions.md,
+  // "Joined sections"), so T is covered twice, and the chord leaves it covered once, when T
+  // meets none of the four caps: the two at this disk lie on other angles (checked on the
+  // grid), and a far cap (p's start, q's end) spans at most half a turn, so the line along
+  // its spoke nearest T separates it from T (checked on T's vertices, with a margin of two
+  // kernel units for the rounding). A spoke to c crosses every neighbouring side within ρ of
+  // it; the chord crosses none.
+  bool chord_is_covered(const MoveCaps& p, const MoveCaps& q, bool right) const {
+    const P2 c = p.c1;
+    const int a = right ? p.front_r : q.back_l, b = right ? q.back_r : p.front_l;
+    const int steps = (a - b + n) % n;  // T spans [b, a] counter-clockwise
+    if (steps == 0 || steps > n / 8) return false;
+    auto strictly_inside = [&](int j) { return j != a && j != b && on_arc(j, b, a, n); };
+    if (strictly_inside(right ? p.front_l : p.front_r) || strictly_inside(right ? q.back_l : q.back_r)) return false;
+    if ((p.back_r - p.back_l + n) % n > n / 2 || (q.front_l - q.front_r + n) % n > n / 2) return false;
+    const P2 tri[3] = {c, {c.x + p.rho1 * uc[static_cast<std::size_t>(a)].x, c.y + p.rho1 * uc[static_cast<std::size_t>(a)].y},
+                       {c.x + p.rho1 * uc[static_cast<std::size_t>(b)].x, c.y + p.rho1 * uc[static_cast<std::size_t>(b)].y}};
+    constexpr double kMargin = 2.0 * kMmPerUnit;
+    // Signed side of T's vertices against the line through o along grid direction j; the
+    // far cap lies where sign * cross <= 0.
+    auto clear_of = [&](P2 o, int j, double sign) {
+      const P2 d = uc[static_cast<std::size_t>(j)];
+      for (const P2& t : tri)
+        if (sign * (d.x * (t.y - o.y) - d.y * (t.x - o.x)) <= kMargin) return false;
+      return true;
+    };
+    // Right side: p's back cap ends at spoke back_r (cap on the clockwise side of it), q's
+    // front cap starts at spoke front_r (cap on the counter-clockwise side). Left: mirrored.
+    return right ? clear_of(p.c0, p.back_r, 1.0) && clear_of(q.c1, q.front_r, -1.0)
+                 : clear_of(p.c0, p.back_l, -1.0) && clear_of(q.c1, q.front_l, 1.0);
   }
   void side(const std::vector<P2>& pts) { buf.insert(buf.end(), pts.begin(), pts.end()); }
 };
@@ -110,9 +132,7 @@ bool append_outline(std::span<const MoveCaps> moves, int n, const std::vector<P2
     const MoveCaps& a = moves[k];
     w.side(a.right);
     if (k + 1 < m) {
-      const MoveCaps& b = moves[k + 1];
-      w.shorter = std::min(a.length, b.length);
-      w.join(a.c1, a.rho1, a.front_r, b.back_r, b.back_l, b.back_r, a.uniform && b.uniform);
+      w.join(a, moves[k + 1], true);
     }
   }
   // Front cap of the last move, then the left sides back.
@@ -121,9 +141,7 @@ bool append_outline(std::span<const MoveCaps> moves, int n, const std::vector<P2
     const MoveCaps& b = moves[k];
     w.side(b.left);
     if (k > 0) {
-      const MoveCaps& a = moves[k - 1];
-      w.shorter = std::min(a.length, b.length);
-      w.join(b.c0, b.rho0, b.back_l, a.front_l, a.front_r, a.front_l, a.uniform && b.uniform);
+      w.join(moves[k - 1], b, false);
     }
   }
   return emit_path(buf, out, spare);
