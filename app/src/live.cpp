@@ -22,15 +22,27 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
   pipeline.start();
   const auto period = static_cast<std::int64_t>(opt.status_period_s * 1e9);
   std::int64_t next_status = sched::now_ns() + period;
+  std::vector<std::string> warnings;
+  const auto check_input = [&] {
+    if (!warnings.empty()) return;  // one warning per run: the mismatch does not change
+    std::string w = pipeline.input_warning();
+    if (w.empty()) return;
+    if (opt.on_warning) opt.on_warning(w);
+    warnings.push_back(std::move(w));
+  };
   while (pipeline.running()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    check_input();
     if (status && sched::now_ns() >= next_status) {
       next_status += period;
       status(pipeline.status_line());
     }
   }
   pipeline.stop();
-  return pipeline.result();
+  check_input();
+  LiveResult r = pipeline.result();
+  r.warnings = std::move(warnings);
+  return r;
 }
 
 std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
@@ -56,6 +68,7 @@ std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   j["sweeps"] = r.sweeps;
   j["batches"] = r.batches;
   j["record_overruns"] = r.record_overruns;
+  j["warnings"] = r.warnings;
   j["samples_coalesced"] = r.samples_coalesced;
   j["overflow_overruns"] = r.overflow_overruns;
   j["overflow_high_water"] = r.overflow_high_water;
@@ -74,8 +87,8 @@ void write_live_outputs(const std::string& dir, const LiveResult& r, const Profi
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw std::runtime_error(dir + ": cannot create output directory: " + ec.message());
-  write_file(dir + "/metrics.json", live_metrics_json(r, profile));
-  write_file(dir + "/levels.lbrs", geom::to_bytes(r.solid));
+  write_file((std::filesystem::path(dir) / "metrics.json").string(), live_metrics_json(r, profile));
+  write_file((std::filesystem::path(dir) / "levels.lbrs").string(), geom::to_bytes(r.solid));
 }
 
 nc::EmulatorLimits live_emulator_limits(const Profile& profile) {

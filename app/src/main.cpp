@@ -1,10 +1,12 @@
 // lbrsim — command-line entry point. Subcommands: batch, view, run, emulate, profile.
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <future>
+#include <mutex>
 #include <optional>
 #include <thread>
 #include <iostream>
@@ -44,13 +46,15 @@ struct BatchOptions {
   // rendering (gfx/)
   std::string png, view = "iso", color = "plain", size = "1024x768";
   bool view_window = false;
+  bool show_tool = false;  // batch --png: a finished-part picture has no tool unless asked for
+  bool no_tool = false;    // view: hide the tool
 };
 
 struct ViewCliOptions {
   bool animate = false, hidden = false, ortho = false, no_vsync = false;
   double speed = 1.0, rate_hz = 30.0;
   int screenshot_every = 0;
-  std::string screenshot_prefix = "lbrsim-frame-";
+  std::string screenshot_prefix = "lbrsim-frame-";  // view has no --out; .gitignore lists these
   std::size_t frames = 0;
 };
 
@@ -58,6 +62,11 @@ struct ViewCliOptions {
 struct EmulateOptions {
   std::string program, profile, period, out = "samples.csv", interpreter = "builtin";
 };
+
+// DIR/NAME as the user would type it ("out/" + metrics.json -> out/metrics.json, not out//).
+std::string out_file(const std::string& dir, const std::string& name) {
+  return (std::filesystem::path(dir) / name).string();
+}
 
 app::Interpreter interpreter_of(const std::string& s) {
   return s == "rs274" ? app::Interpreter::Rs274 : app::Interpreter::Builtin;
@@ -112,7 +121,9 @@ gfx::CaptureOptions capture_options(const BatchOptions& o) {
 void write_png_if_asked(const geom::LbrSolid& solid, const BatchOptions& o, const gfx::CaptureOptions& cap,
                         const std::vector<gfx::ToolState>& tools) {
   if (o.png.empty()) return;
-  gfx::capture_png(solid, o.png, cap, tools);
+  // A picture of the finished part: the tool would hide part of it (issue 19), so it is
+  // drawn only with --show-tool.
+  gfx::capture_png(solid, o.png, cap, o.show_tool && !o.no_tool ? tools : std::vector<gfx::ToolState>{});
   std::printf("wrote %s (%dx%d, view %s, colour %s)\n", o.png.c_str(), cap.width, cap.height, o.view.c_str(),
               o.color.c_str());
 }
@@ -123,7 +134,7 @@ void print_result(const app::BatchResult& r, const BatchOptions& o) {
               r.removed_volume_mm3, r.stock_volume_mm3, r.machining_time_s, r.wall_time_s,
               r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0, r.solid.levels(), r.solid.regions(),
               r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
-  std::printf("wrote %s/metrics.json and %s/levels.lbrs\n", o.out.c_str(), o.out.c_str());
+  std::printf("wrote %s and %s\n", out_file(o.out, "metrics.json").c_str(), out_file(o.out, "levels.lbrs").c_str());
   app::write_mesh_files(r.solid, o.stl, o.ply);
   if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
   if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
@@ -171,6 +182,7 @@ gfx::RenderThreadConfig render_config(const BatchOptions& o, const ViewCliOption
   gfx::parse_size(o.size, rc.width, rc.height);
   rc.screenshot_every = v.screenshot_every;
   rc.screenshot_prefix = v.screenshot_prefix;
+  rc.render.show_tools = !o.no_tool;
   return rc;
 }
 
@@ -201,6 +213,7 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
 }
 
 int run_batch_command(const BatchOptions& o) {
+  if (o.quiet) spdlog::set_level(spdlog::level::warn);  // --quiet: the result lines and warnings only
   const app::Profile profile = batch_profile(o);
   const gfx::CaptureOptions cap = capture_options(o);
   if (!profile.channels.empty()) return run_channels_command(o, profile, cap);
@@ -238,16 +251,42 @@ struct RunOptions {
   app::LiveOptions live;
   bool quiet = false;
   // rendering (gfx/): a viewer window when a display exists, screenshots on request
-  bool no_window = false, hidden = false;
+  bool no_window = false, hidden = false, no_tool = false;
   int screenshot_every = 0;
-  std::string screenshot_prefix = "lbrsim-frame-";
+  std::string screenshot_prefix;  // empty: OUT/frame-
   std::string view = "iso", color = "heat", size = "1280x800";
   double rate_hz = 0.0;  // 0: the profile's [render] rate_hz
 };
 
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop.store(true); }
+std::atomic<bool> g_signalled{false}, g_window_closed{false};
+extern "C" void on_signal(int) {
+  g_signalled.store(true);
+  g_stop.store(true);
+}
+
+// Results of `lbrsim run` must survive the display (issue 19): the live thread writes them
+// as soon as the run ends, before the window and GL context are torn down, and a lost X
+// connection (xvfb-run ending on Ctrl-C, the session closing) stops the run and waits for
+// them before the process leaves.
+enum class Results : int { NotStarted, Running, Written, Failed };
+std::atomic<Results> g_results{Results::NotStarted};
+std::atomic<const char*> g_results_dir{""};
+
+void on_display_lost() {
+  g_stop.store(true);
+  std::fprintf(stderr, "lbrsim: warning: display lost (the X server connection closed); stopping the run\n");
+  for (int i = 0; i < 60000 && g_results.load() == Results::Running; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const Results r = g_results.load();
+  if (r == Results::Written)
+    std::fprintf(stderr, "lbrsim: results written to %s (metrics.json, levels.lbrs)\n", g_results_dir.load());
+  else if (r != Results::NotStarted)
+    std::fprintf(stderr, "lbrsim: error: results could not be written after the display was lost\n");
+  std::fflush(stdout);
+  std::_Exit(r == Results::Written ? 0 : 1);  // Xlib would exit(1) on return; no destructors with threads running
+}
 
 void install_stop_handlers() {
   struct sigaction sa {};
@@ -265,8 +304,21 @@ gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profi
   rc.render.color = gfx::parse_color_mode(o.color);
   gfx::parse_size(o.size, rc.width, rc.height);
   rc.screenshot_every = o.screenshot_every;
-  rc.screenshot_prefix = o.screenshot_prefix;
+  rc.screenshot_prefix = o.screenshot_prefix.empty() ? out_file(o.out, "frame-") : o.screenshot_prefix;
+  rc.render.show_tools = !o.no_tool;
   return rc;
+}
+
+// metrics.json, levels.lbrs and the mesh files of a finished (or stopped) live run.
+void write_live_results(const RunOptions& o, const app::Profile& profile, const app::LiveResult& r) {
+  try {
+    app::write_live_outputs(o.out, r, profile);
+    app::write_mesh_files(r.solid, o.stl, o.ply);
+  } catch (...) {
+    g_results.store(Results::Failed);
+    throw;
+  }
+  g_results.store(Results::Written);
 }
 
 void log_render_report(const gfx::PacingReport& rep, double rate_hz) {
@@ -284,6 +336,40 @@ void log_render_report(const gfx::PacingReport& rep, double rate_hz) {
                P::percentile(rebuilt, 1.0), rep.screenshots, rep.gl);
 }
 
+// Warnings from the live run for the HUD: the live thread may warn before the render
+// thread exists or after it is gone.
+class HudNotice {
+ public:
+  void attach(gfx::RenderThread* rt) {
+    std::lock_guard lock(mu_);
+    rt_ = rt;
+    push();
+  }
+  void set(const std::string& text) {
+    std::lock_guard lock(mu_);
+    text_.clear();
+    std::size_t col = 0;  // wrapped at about 100 characters: the HUD has no wrapping of its own
+    for (char c : text) {
+      if (c == ' ' && col > 100) {
+        text_ += "\n  ";
+        col = 2;
+        continue;
+      }
+      text_ += c;
+      ++col;
+    }
+    push();
+  }
+
+ private:
+  void push() {
+    if (rt_ != nullptr && !text_.empty()) rt_->edit([&](gfx::Camera&, gfx::RenderOptions& ro) { ro.notice = text_; });
+  }
+  std::mutex mu_;
+  gfx::RenderThread* rt_ = nullptr;
+  std::string text_;
+};
+
 // The live run on its own thread while the main thread owns the window's events and the
 // render thread draws what the geometry thread publishes.
 app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profile, const app::StatusFn& status) {
@@ -294,6 +380,11 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
   std::promise<std::unique_ptr<geom::LbrSolid>> initial;
   auto initial_ready = initial.get_future();
   app::LiveOptions lo = o.live;
+  HudNotice notice;
+  lo.on_warning = [&notice, warn = o.live.on_warning](const std::string& w) {
+    if (warn) warn(w);
+    notice.set(w);
+  };
   lo.exchange = &ex;
   lo.on_start = [&initial](const geom::LbrSolid& s) { initial.set_value(std::make_unique<geom::LbrSolid>(s)); };
   std::optional<app::LiveResult> result;
@@ -302,7 +393,10 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
   std::thread live([&] {
     try {
       result.emplace(app::run_live(profile, lo, g_stop, status));
+      write_live_results(o, profile, *result);  // before anything that needs the display
     } catch (...) {
+      Results running = Results::Running;
+      g_results.compare_exchange_strong(running, Results::Failed);
       live_error = std::current_exception();
       try {
         initial.set_value(nullptr);
@@ -316,13 +410,19 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
     gfx::RenderThread rt(win, ex, *start, rc);
     start.reset();
     rt.start();
+    notice.attach(&rt);
     if (visible) {
       gfx::run_event_loop(win, rt, [&] { return !live_done.load(); });
+      if (!live_done.load() && rt.running()) {  // the window was closed: end the run, keep its results
+        g_window_closed.store(true);
+        g_stop.store(true);
+      }
     } else {
       while (!live_done.load() && rt.running()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     // Show the final state for one more frame period before closing.
     std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(2000.0 / rc.rate_hz)));
+    notice.attach(nullptr);
     rt.stop();
     log_render_report(rt.report(), rc.rate_hz);
   }
@@ -340,12 +440,13 @@ void print_live_summary(const RunOptions& o, const app::LiveResult& r) {
               static_cast<unsigned long long>(r.samples_applied), static_cast<unsigned long long>(r.samples_lost),
               static_cast<unsigned long long>(r.ring_overruns), static_cast<unsigned long long>(r.ring_high_water),
               static_cast<unsigned long long>(errors), r.lag_p50_ms, r.lag_p99_ms, r.lag_max_ms, r.removed_volume_mm3,
-              r.rt_mode.c_str(), g_stop.load() ? " | stopped by signal" : "");
-  std::printf("wrote %s/metrics.json and %s/levels.lbrs%s%s%s%s\n", o.out.c_str(), o.out.c_str(),
+              r.rt_mode.c_str(), g_signalled.load() ? " | stopped by signal" : (g_window_closed.load() ? " | stopped: window closed" : ""));
+  std::printf("wrote %s and %s%s%s%s%s\n", out_file(o.out, "metrics.json").c_str(), out_file(o.out, "levels.lbrs").c_str(),
               o.stl.empty() ? "" : ", ", o.stl.c_str(), o.ply.empty() ? "" : ", ", o.ply.c_str());
 }
 
-int run_live_command(const RunOptions& o) {
+int run_live_command(RunOptions o) {
+  o.live.on_warning = [](const std::string& w) { spdlog::warn("{}", w); };
   const app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
   install_stop_handlers();
   spdlog::info("run: source {}, profile {}, period {} ms", o.live.source, profile.source, profile.live.period_ms);
@@ -357,10 +458,17 @@ int run_live_command(const RunOptions& o) {
     throw gfx::DisplayError("--screenshot-every needs an X or Wayland display for its hidden OpenGL window, and "
                             "neither DISPLAY nor WAYLAND_DISPLAY is set. Run it under a virtual X server: "
                             "`xvfb-run -a lbrsim run ...`");
-  const app::LiveResult r =
-      want_render ? run_live_rendered(o, profile, status) : app::run_live(profile, o.live, g_stop, status);
-  app::write_live_outputs(o.out, r, profile);
-  app::write_mesh_files(r.solid, o.stl, o.ply);
+  g_results_dir.store(o.out.c_str());
+  g_results.store(Results::Running);
+  if (want_render) {
+    gfx::set_display_lost_handler(on_display_lost);
+    if (o.screenshot_prefix.empty()) std::filesystem::create_directories(o.out);  // screenshots go there
+    const app::LiveResult r = run_live_rendered(o, profile, status);  // writes the results itself
+    print_live_summary(o, r);
+    return 0;
+  }
+  const app::LiveResult r = app::run_live(profile, o.live, g_stop, status);
+  write_live_results(o, profile, r);
   print_live_summary(o, r);
   return 0;
 }
@@ -405,6 +513,8 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
 
   batch->add_option("--png", b.png, "Render the result offscreen to this PNG (needs a display; headless: xvfb-run -a)");
   add_render_options(batch, b);
+  batch->add_flag("--show-tool", b.show_tool, "--png: draw the tool at its last position (default: the part alone)");
+  batch->add_flag("--no-tool", b.no_tool, "--png: no tool in the picture (the default)")->excludes("--show-tool");
   batch->add_flag("--view-window", b.view_window, "Then open the interactive viewer on the program (runs it again)");
   return batch;
 }
@@ -422,6 +532,7 @@ CLI::App* add_view_command(CLI::App& cli, BatchOptions& vb, ViewCliOptions& vv) 
   view->add_option("--regions", vb.regions, "Region grid NXxNY or auto");
   view->add_flag("--quiet", vb.quiet, "Fewer messages");
   add_render_options(view, vb);
+  view->add_flag("--no-tool", vb.no_tool, "Do not draw the tool (key K toggles it)");
   view->add_flag("--animate", vv.animate, "Stream the program through the kernel in real time (geometry thread)");
   view->add_option("--speed", vv.speed, "Simulated seconds per second when animating")->check(CLI::Range(0.01, 1000.0));
   view->add_option("--rate", vv.rate_hz, "Render rate [Hz]")->check(CLI::Range(1.0, 240.0))->capture_default_str();
@@ -454,8 +565,9 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
   run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "
                   "headless: xvfb-run -a)")->check(CLI::Range(0, 1000000));
-  run->add_option("--screenshot-prefix", ro.screenshot_prefix, "Screenshot file prefix (PREFIX000123.png)")
-      ->capture_default_str();
+  run->add_option("--screenshot-prefix", ro.screenshot_prefix,
+                  "Screenshot file prefix (PREFIX000123.png); default: OUT/frame- in the --out directory");
+  run->add_flag("--no-tool", ro.no_tool, "Do not draw the tool (key K toggles it)");
   run->add_option("--view", ro.view, "Camera: top, front, side or iso")
       ->check(CLI::IsMember({"top", "front", "side", "iso"}))
       ->capture_default_str();

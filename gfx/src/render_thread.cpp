@@ -104,6 +104,7 @@ void RenderThread::loop() {
         ren.options().show_tools = opt_.show_tools;
         ren.options().show_path = opt_.show_path;
         ren.options().show_hud = opt_.show_hud;
+        if (ren.options().notice != opt_.notice) ren.options().notice = opt_.notice;
         w = w_;
         h = h_;
       }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -525,6 +526,10 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
                       static_cast<unsigned long long>(L.samples_held), L.realtime ? "RT (SCHED_FIFO)" : "non-RT");
       else
         std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "no live source (batch result)\n");
+    }
+    if (!opt_.notice.empty()) {
+      const std::size_t used = std::strlen(buf);
+      std::snprintf(buf + used, sizeof buf - used, "WARNING: %s\n", opt_.notice.c_str());
     }
     g.hud->draw(buf, w, h);
   }

@@ -6,6 +6,7 @@
 #include <epoxy/gl.h>
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
+#include <X11/Xlib.h>  // XSetIOErrorHandler only (GLFW's X11 backend owns the connection)
 
 namespace lbr::gfx {
 
@@ -14,6 +15,13 @@ namespace {
 std::mutex g_mutex;  // GLFW init refcount and last error (main thread only in practice)
 int g_windows = 0;
 std::string g_last_error;
+
+DisplayLostHandler g_display_lost = nullptr;
+
+int on_x_io_error(Display*) {
+  if (g_display_lost != nullptr) g_display_lost();
+  return 0;  // Xlib exits after this
+}
 
 void on_glfw_error(int code, const char* msg) {
   g_last_error = std::string(msg ? msg : "?") + " (GLFW error " + std::to_string(code) + ")";
@@ -25,6 +33,11 @@ bool display_available() noexcept {
   const char* d = std::getenv("DISPLAY");
   const char* w = std::getenv("WAYLAND_DISPLAY");
   return (d && *d) || (w && *w);
+}
+
+void set_display_lost_handler(DisplayLostHandler handler) noexcept {
+  g_display_lost = handler;
+  XSetIOErrorHandler(handler != nullptr ? on_x_io_error : nullptr);
 }
 
 Window::Window(int width, int height, bool visible, const std::string& title) : visible_(visible) {

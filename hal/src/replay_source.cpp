@@ -100,6 +100,7 @@ class ReplaySource final : public Source {
         const int k = frame_to_samples(f, cfg_, now, out_, counters_);
         if (k > 0) sink.on_samples(std::span<const AxisSample>(out_.data(), static_cast<std::size_t>(k)));
         else ++mapped_lost_;
+        if (f.n < serial_positions_needed(cfg_)) note_short_frame(f.n, serial_positions_needed(cfg_));
       });
     } else {
       if (record_) {

@@ -44,6 +44,7 @@ class SerialSource final : public Source {
   SerialSource(std::string dev, const LiveConfig& cfg) : dev_(std::move(dev)), cfg_(cfg) {
     if (cfg_.axes.empty()) cfg_.axes = default_axes();
     baud_ = baud_of(cfg_.serial.baud);
+    needed_ = serial_positions_needed(cfg_);
   }
   ~SerialSource() override { close(); }
 
@@ -113,6 +114,7 @@ class SerialSource final : public Source {
                 const int k = frame_to_samples(f, cfg_, now, out_, counters_);
                 if (k > 0) sink.on_samples(std::span<const AxisSample>(out_.data(), static_cast<std::size_t>(k)));
                 else ++mapped_lost_;
+                if (f.n < needed_) note_short_frame(f.n, needed_);
               });
     return PollResult::Data;
   }
@@ -133,6 +135,7 @@ class SerialSource final : public Source {
   SerialStreamDecoder dec_;
   std::array<AxisSample, kMaxChannels> out_{};
   std::uint64_t mapped_lost_ = 0;
+  int needed_ = 0;
 };
 
 }  // namespace

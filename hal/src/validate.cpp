@@ -1,5 +1,6 @@
 #include "hal/validate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -88,6 +89,12 @@ bool Validator::accept(const AxisSample& s, Counters& c) noexcept {
   ref.seq = s.seq;
   ref.q = s.q;
   return true;
+}
+
+int serial_positions_needed(const LiveConfig& cfg) noexcept {
+  int n = 0;
+  for (const AxisMap& m : cfg.axes) n = std::max(n, m.index + 1);
+  return n;
 }
 
 int frame_to_samples(const SerialFrame& f, const LiveConfig& cfg, std::int64_t now_mono_ns,

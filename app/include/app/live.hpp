@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/profile.hpp"
 #include "geom/lbr_solid.hpp"
@@ -29,8 +30,13 @@ namespace lbr::app {
 struct LiveOptions {
   std::string source;     // can:IF | serial:DEV | replay:FILE | emulator:PROGRAM
   double speed = 1.0;     // replay/emulator: 1 = real time, 0 = as fast as possible
-  std::string record;     // write the raw input to this file (candump -l format)
+  std::string record;     // write the raw input to this file (candump -l format; the emulator's
+                          // samples as the serial frames of the profile's mapping)
   double status_period_s = 1.0;
+  // Warnings about the input the operator must see even with --quiet, e.g. serial frames
+  // with fewer positions than the profile maps (called once per kind, within 0.1 s of
+  // the first such frame, on the control thread).
+  std::function<void(const std::string&)> on_warning;
   // Rendering (docs/rendering.md §7). When set, the geometry thread publishes to the
   // exchange after every batch (never waiting) and records tip positions for the path;
   // `on_start` receives the solid before any thread starts (the render side's initial copy).
@@ -71,6 +77,7 @@ struct LiveResult {
   std::uint64_t samples_coalesced = 0, overflow_overruns = 0, overflow_high_water = 0, overflow_capacity = 0;
   std::uint64_t kernel_calls = 0, sweeps_split = 0, samples_unapplied = 0;
   double stop_latency_ms = 0;
+  std::vector<std::string> warnings{};  // as given to LiveOptions::on_warning
 };
 
 using StatusFn = std::function<void(const std::string& line)>;
@@ -97,6 +104,8 @@ class LivePipeline {
   [[nodiscard]] bool running() const noexcept;
   // One status line with the counters so far (the caller's thread, once a second).
   [[nodiscard]] std::string status_line();
+  // A warning about input that does not match the profile, or "" (control thread).
+  [[nodiscard]] std::string input_warning() const;
   // Asks the source loop to end without waiting (any thread).
   void request_stop() noexcept;
   void stop();

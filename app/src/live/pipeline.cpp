@@ -276,6 +276,17 @@ void LivePipeline::start() {
 
 bool LivePipeline::running() const noexcept { return impl_->geo_running.load(std::memory_order_acquire); }
 
+std::string LivePipeline::input_warning() const {
+  const Impl& p = *impl_;
+  if (!p.src) return "";
+  const hal::InputMismatch m = p.src->input_mismatch();
+  if (m.positions_carried == 0) return "";
+  return p.src->describe() + ": frames carry " + std::to_string(m.positions_carried) + " position" +
+         (m.positions_carried == 1 ? "" : "s") + ", the profile maps " + std::to_string(m.positions_needed) + " (" +
+         p.profile.source + ", [[live.axis]] index up to " + std::to_string(m.positions_needed - 1) +
+         "); no sample can be used. Give the sender and lbrsim the same profile (lbr-feed-serial --profile FILE)";
+}
+
 std::string LivePipeline::status_line() {
   Impl& p = *impl_;
   snapshot(p);

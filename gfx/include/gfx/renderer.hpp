@@ -26,6 +26,7 @@ struct RenderOptions {
   bool show_tools = true;
   bool show_path = true;
   bool show_hud = true;
+  std::string notice;  // a warning line on the HUD (e.g. input that does not match the profile)
   mesh::MeshOptions mesh;
   int max_regions_per_frame = 16;   // upper bound of the adaptive per-frame rebuild limit
   double mesh_budget_ms = 12.0;     // rebuild time per frame the limit adapts to [ms]

@@ -20,6 +20,14 @@ class DisplayError : public std::runtime_error {
 // True when DISPLAY or WAYLAND_DISPLAY is set (a window can be attempted).
 [[nodiscard]] bool display_available() noexcept;
 
+// Called when the connection to the X server is lost (the server ended, as at the end of
+// `xvfb-run`, or the session closed), on whichever thread made the failing request. Xlib
+// ends the process when the handler returns, so a handler finishes what must not be lost
+// (results) and leaves with std::_Exit. Process-wide; set it before creating windows;
+// nullptr restores Xlib's default (print and exit(1)).
+using DisplayLostHandler = void (*)();
+void set_display_lost_handler(DisplayLostHandler handler) noexcept;
+
 class Window {
  public:
   // Throws DisplayError (with a hint to use xvfb-run) when no display is available, and

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -37,6 +38,14 @@ class SampleSink {
   ~SampleSink() = default;
 };
 
+// Input whose shape does not match the profile's [[live.axis]] mapping: serial frames with
+// fewer positions than the highest mapped index needs. Every such frame is only counted as
+// `incomplete`; this says why, for a warning the operator sees (issue 19).
+struct InputMismatch {
+  int positions_carried = 0;  // by the latest frame that was too short; 0: none seen
+  int positions_needed = 0;   // highest mapped index + 1
+};
+
 enum class PollResult {
   Data,   // input was processed (samples may or may not have been produced)
   Idle,   // timeout without input
@@ -59,10 +68,22 @@ class Source {
   [[nodiscard]] virtual std::uint64_t lost() const noexcept = 0;
   [[nodiscard]] const Counters& counters() const noexcept { return counters_; }
   void set_recording(bool on) noexcept { record_ = on; }
+  // The latest mismatch between input and mapping (any thread; relaxed atomics).
+  [[nodiscard]] InputMismatch input_mismatch() const noexcept {
+    return {short_frame_positions_.load(std::memory_order_relaxed), positions_needed_.load(std::memory_order_relaxed)};
+  }
 
  protected:
+  // Decoders call this (HAL thread, RT-safe) for a frame with too few positions.
+  void note_short_frame(int carried, int needed) noexcept {
+    positions_needed_.store(needed, std::memory_order_relaxed);
+    short_frame_positions_.store(carried, std::memory_order_relaxed);
+  }
   Counters counters_;
   bool record_ = false;
+
+ private:
+  std::atomic<int> short_frame_positions_{0}, positions_needed_{0};
 };
 
 // Generates positions for GeneratorSource (the machine emulator, app/). Called on the

@@ -45,4 +45,7 @@ class Validator {
 int frame_to_samples(const SerialFrame& f, const LiveConfig& cfg, std::int64_t now_mono_ns,
                      std::span<AxisSample, kMaxChannels> out, Counters& c) noexcept;
 
+// Positions a serial frame must carry for cfg.axes: the highest mapped index + 1. RT-safe.
+[[nodiscard]] int serial_positions_needed(const LiveConfig& cfg) noexcept;
+
 }  // namespace lbr::hal
