@@ -36,7 +36,16 @@ geom::LbrSolid cylinder(double cx, double r, int points, int levels) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string dir = argc > 1 ? argv[1] : "bench-out";
+  const std::string arg = argc > 1 ? argv[1] : "";
+  if (arg == "--help" || arg == "-h" || argc > 2 || (!arg.empty() && arg[0] == '-')) {
+    std::fprintf(arg == "--help" || arg == "-h" ? stdout : stderr,
+                 "usage: %s [OUTDIR=bench-out]\n"
+                 "Paper Fig. 4: the time of one 3D boolean (cylinder minus cylinder) against levels and points\n"
+                 "per level; writes OUTDIR/fig4.csv and, with gnuplot, OUTDIR/fig4.png.\n",
+                 argv[0]);
+    return arg == "--help" || arg == "-h" ? 0 : 2;
+  }
+  const std::string dir = arg.empty() ? "bench-out" : arg;
   std::filesystem::create_directories(dir);
   const std::string csv = dir + "/fig4.csv";
   FILE* f = std::fopen(csv.c_str(), "w");

@@ -18,9 +18,15 @@
 
 int main(int argc, char** argv) {
   using namespace lbr;
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: %s PROGRAM [SECONDS=60] [SPEED=1] [WxH=1280x800] [RATE=30] [COLOR=heat]\n", argv[0]);
-    return 2;
+  const std::string first = argc > 1 ? argv[1] : "";
+  const bool help = first == "--help" || first == "-h";
+  if (argc < 2 || help || first[0] == '-') {
+    std::fprintf(help ? stdout : stderr,
+                 "usage: %s PROGRAM [SECONDS=60] [SPEED=1] [WxH=1280x800] [RATE=30] [COLOR=heat]\n"
+                 "Frame pacing of the render thread while PROGRAM streams through the kernel; needs a display\n"
+                 "(headless: xvfb-run -a %s PROGRAM 60).\n",
+                 argv[0], argv[0]);
+    return help ? 0 : 2;
   }
   try {
     const std::string program = argv[1];

@@ -3,6 +3,9 @@
 # (config/profiles/live-6axis.toml) into `lbrsim run --source serial:PTY`; prints the
 # metrics that docs/performance.md reports. Usage: tools/bench-live.sh [BUILD] [SAMPLES] [PROGRAM]
 set -euo pipefail
+if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then  # usage: the comment above
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0
+fi
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 BUILD="${1:-$ROOT/build}"
 SAMPLES="${2:-30000}"

@@ -9,6 +9,9 @@
 # Either way lbrsim-out/ ends up with metrics.json, levels.lbrs and part.stl (and the PNGs).
 # Extra arguments go to `lbrsim run` (e.g. --speed 5, --profile FILE, --source ...).
 set -euo pipefail
+if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then  # usage: the comment above
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0
+fi
 cd "$(dirname "$0")/.."
 tools/setup-debian.sh
 tools/build.sh

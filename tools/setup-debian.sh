@@ -2,6 +2,9 @@
 # Installs every Debian 12 package lbrsim needs to build, run, test and benchmark.
 # Idempotent: installs only what is missing. Runs as root, or through sudo when available.
 set -euo pipefail
+if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then  # usage: the comment above
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0
+fi
 
 PACKAGES=(
   # toolchain

@@ -6,6 +6,9 @@
 # where clang is installed, the libFuzzer decoder targets for a fixed number of runs
 # (build-fuzz/, label fuzz). Set LBR_SKIP_SANITIZERS=1 to skip these stages locally.
 set -euo pipefail
+if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then  # usage: the comment above
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0
+fi
 cd "$(dirname "$0")/.."
 tools/setup-debian.sh
 tools/build.sh -DLBR_BUILD_TESTS=ON

@@ -131,8 +131,24 @@ class SocketCanSource final : public Source {
   bool connect(std::string& err) {
     const char* what = nullptr;
     if (connect_impl(what)) return true;
-    err = std::string(what) + ": " + std::strerror(errno);
+    const int e = errno;
+    err = std::string(what) + ": " + std::strerror(e) + hint(e, what);
     return false;
+  }
+  // What to do about the usual set-up faults (issue 19): the message alone names a socket
+  // call, not the missing kernel module or interface.
+  [[nodiscard]] std::string hint(int e, const char* what) const {
+    const std::string up = "`sudo ip link set " + iface_ + " up type can bitrate 1000000` (a real adapter; its bitrate) "
+                           "or a virtual bus: `sudo ip link add dev " + iface_ + " type vcan && sudo ip link set " + iface_ + " up`";
+    if (e == EAFNOSUPPORT || e == EPROTONOSUPPORT)
+      return ". This kernel has no SocketCAN (AF_CAN): load the modules with `sudo modprobe can can_raw` and, for a "
+             "virtual bus, `sudo modprobe vcan` (or the adapter's driver, e.g. gs_usb, peak_usb); then bring the "
+             "interface up: " + up + ". Containers and WSL kernels often lack CAN entirely: run on the host, or "
+             "try tools/hil/hil-bench.sh (vcan in a VM)";
+    if (std::string(what) == "no such interface")
+      return ". Create it: " + up + " (`ip -details link show type can` lists CAN interfaces)";
+    if (e == ENETDOWN) return ". Bring it up: " + up;
+    return "";
   }
   bool connect_impl(const char*& what) noexcept {
     const int s = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);

@@ -9,6 +9,9 @@
 # Usage: tools/hil/hil-bench.sh [BUILD_DIR] [WORK_DIR]   (needs qemu-system-x86,
 # busybox-static, cpio; downloads the kernel package once into WORK_DIR with apt-get).
 set -euo pipefail
+if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then  # usage: the comment above
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0
+fi
 ROOT="$(cd "$(dirname "$0")/../.." && pwd)"
 BUILD="$(cd "${1:-$ROOT/build}" && pwd)"
 WORK="${2:-$BUILD/hil}"
