@@ -626,6 +626,7 @@ SubtractStats LbrSolid::subtract_shared(SubtractShared& sh, SubtractWorkspace& w
 void LbrSolid::build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                            SubtractStats& stats) const {
   const double zc = level_z_mm(level);
+  ws.prev_tilted_valid = false;
   for (Path& p : ls.paths) ws.scratch.spare.push_back(std::move(p));  // keep the buffers
   ls.paths.clear();
   ls.box.clear();
@@ -748,10 +749,43 @@ void LbrSolid::build_run_sections(double zc, std::pair<std::uint32_t, std::uint3
         }
       }
       if (ws.scratch.core.valid()) prev_core = ws.scratch.core;
+    } else if (!sw.vertical()) {
+      trim_tilted(si, before, sh, ws, ls, stats);
     }
     push_boxes(before, sh.sweep_id[si]);
     ++si;
   }
+}
+
+// A tilted move's sections (one per sub-step) on a level overlap the previous sub-step's and
+// the previous tilted move's as much as vertical ones do: each is trimmed by the previous
+// one, as it was before its own trimming (convex; trim_covered() with a polygon).
+void LbrSolid::trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
+                           LevelSections& ls, SubtractStats& stats) const {
+  const Sweep& sw = sh.sweeps[si];
+  bool covered = ws.prev_tilted_valid && ws.prev_tilted_sweep + 1 == si &&
+                 &sh.sweeps[si - 1].shape() == &sw.shape() && sh.sweeps[si - 1].to().tip == sw.from().tip;
+  std::size_t w = before;
+  for (std::size_t k = before; k < ls.paths.size(); ++k) {
+    ws.tilted_next = ls.paths[k];
+    bool keep = true;
+    if (covered) {
+      const std::size_t vertices = ls.paths[k].size();
+      keep = trim_covered(ls.paths[k], ws.prev_tilted, ws.trim_flags);
+      if (!keep || ls.paths[k].size() != vertices) ++stats.sections_trimmed;
+    }
+    ws.prev_tilted.swap(ws.tilted_next);
+    covered = true;
+    if (!keep) {
+      ws.scratch.spare.push_back(std::move(ls.paths[k]));
+      continue;
+    }
+    if (w != k) ls.paths[w] = std::move(ls.paths[k]);
+    ++w;
+  }
+  ls.paths.resize(w);
+  ws.prev_tilted_valid = w > before || covered;
+  ws.prev_tilted_sweep = si;
 }
 
 // The chain offset `o` cut to `region` (grown by 1 mm); the first thread that needs a piece

@@ -482,6 +482,46 @@ bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) co
   return true;
 }
 
+namespace {
+
+// Drops the vertices of convex polygon b for which inside() holds, keeping the first and
+// last vertex of each such run (what b loses is the hull of a run, which lies inside the
+// covering region when that is convex). False when every vertex is inside.
+template <class Inside>
+bool trim_inside(Path& b, std::vector<std::uint8_t>& flags, Inside inside) {
+  const std::size_t n = b.size();
+  flags.resize(n);
+  std::size_t in_count = 0, start = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool in = inside(b[i]);
+    flags[i] = in ? 1 : 0;
+    in_count += in ? 1 : 0;
+    if (!in && start == n) start = i;
+  }
+  if (start == n) return false;
+  if (in_count <= 2) return true;
+  // From an outside vertex on, keep the outside vertices and both ends of each inside run;
+  // written in place (the write index never passes the read index).
+  std::rotate(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(start), b.end());
+  std::rotate(flags.begin(), flags.begin() + static_cast<std::ptrdiff_t>(start), flags.end());
+  std::size_t w = 0, i = 0;
+  while (i < n) {
+    if (flags[i] == 0) {
+      b[w++] = b[i++];
+      continue;
+    }
+    std::size_t j = i;
+    while (j < n && flags[j] != 0) ++j;
+    b[w++] = b[i];
+    if (j - i >= 2) b[w++] = b[j - 1];
+    i = j;
+  }
+  b.resize(w);
+  return true;
+}
+
+}  // namespace
+
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin) {
   const std::size_t n = b.size();
   if (!a.valid() || n < 4) return true;
@@ -511,34 +551,39 @@ bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, d
     if (kk > aa * h) return r2 > 0.0 && perp * perp + (along - h) * (along - h) <= r2 * r2;
     return aa * perp + bb * along <= r1;
   };
-  flags.resize(n);
-  std::size_t in_count = 0, start = n;
-  for (std::size_t i = 0; i < n; ++i) {
-    const bool in = inside(b[i]);
-    flags[i] = in ? 1 : 0;
-    in_count += in ? 1 : 0;
-    if (!in && start == n) start = i;
-  }
-  if (start == n) return false;
-  if (in_count <= 2) return true;
-  // From an outside vertex on, keep the outside vertices and both ends of each inside run;
-  // written in place (the write index never passes the read index).
-  std::rotate(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(start), b.end());
-  std::rotate(flags.begin(), flags.begin() + static_cast<std::ptrdiff_t>(start), flags.end());
-  std::size_t w = 0, i = 0;
-  while (i < n) {
-    if (flags[i] == 0) {
-      b[w++] = b[i++];
-      continue;
+  return trim_inside(b, flags, inside);
+}
+
+bool trim_covered(Path& b, const Path& a, std::vector<std::uint8_t>& flags, double margin) {
+  const std::size_t na = a.size();
+  if (na < 3 || b.size() < 4) return true;
+  // a is convex and counter-clockwise: the wedge from a[0] that holds q, then q's distance
+  // to that wedge's edge and its neighbours (the edges a point near a vertex is nearest to).
+  const Rect box = bounds_of(a);
+  auto side = [&](std::size_t i, const Point& q) {  // signed distance to edge i -> i+1 [units]
+    const Point& p0 = a[i];
+    const Point& p1 = a[(i + 1) % na];
+    const double ex = static_cast<double>(p1.X - p0.X), ey = static_cast<double>(p1.Y - p0.Y);
+    const double l = std::hypot(ex, ey);
+    const double c = ex * static_cast<double>(q.Y - p0.Y) - ey * static_cast<double>(q.X - p0.X);
+    return l > 0.0 ? c / l : c;
+  };
+  auto cross0 = [&](std::size_t i, const Point& q) {
+    return static_cast<double>(a[i].X - a[0].X) * static_cast<double>(q.Y - a[0].Y) -
+           static_cast<double>(a[i].Y - a[0].Y) * static_cast<double>(q.X - a[0].X);
+  };
+  auto inside = [&](const Point& q) {
+    if (q.X <= box.x0 || q.X >= box.x1 || q.Y <= box.y0 || q.Y >= box.y1) return false;
+    if (cross0(1, q) <= 0.0 || cross0(na - 1, q) >= 0.0) return false;
+    std::size_t lo = 1, hi = na - 1;  // q lies between rays a0->a[lo] and a0->a[hi]
+    while (hi - lo > 1) {
+      const std::size_t mid = (lo + hi) / 2;
+      if (cross0(mid, q) > 0.0) lo = mid;
+      else hi = mid;
     }
-    std::size_t j = i;
-    while (j < n && flags[j] != 0) ++j;
-    b[w++] = b[i];
-    if (j - i >= 2) b[w++] = b[j - 1];
-    i = j;
-  }
-  b.resize(w);
-  return true;
+    return side(lo, q) >= margin && side((lo + na - 1) % na, q) >= margin && side(hi % na, q) >= margin;
+  };
+  return trim_inside(b, flags, inside);
 }
 
 const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {

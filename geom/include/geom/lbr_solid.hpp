@@ -185,6 +185,9 @@ struct SubtractWorkspace {
   std::vector<MoveCaps> caps;                 // one per move of a joined run
   std::vector<SectionScratch::P2> outline;    // a joined run's vertices before rounding
   Path cut, cut_tmp;                          // a long section cut to a region
+  Path prev_tilted, tilted_next;              // the last tilted section of a level, untrimmed
+  bool prev_tilted_valid = false;
+  std::uint32_t prev_tilted_sweep = 0;
   std::vector<std::uint8_t> trim_flags;
   std::vector<int> source;          // per (level - lb, region): the level whose result it takes
   std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip
@@ -286,6 +289,8 @@ class LbrSolid {
   // Phases of subtract_shared().
   void build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& out,
                    SubtractStats& stats) const;
+  void trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
+                   LevelSections& ls, SubtractStats& stats) const;
   void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
                           SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   const Paths& offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const;

@@ -88,6 +88,9 @@ struct MoveCaps {
 };
 
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
+// The same with a convex counter-clockwise polygon `a` (the previous tilted section) as the
+// covering region: O(log |a|) per vertex of b.
+bool trim_covered(Path& b, const Path& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
 
 class Sweep {
  public:
@@ -102,6 +105,8 @@ class Sweep {
   // True when both poses have the axis exactly +Z (the 3-axis fast path).
   [[nodiscard]] bool vertical() const noexcept { return vertical_; }
   [[nodiscard]] const CutterShape& shape() const noexcept { return *shape_; }
+  [[nodiscard]] const Pose& from() const noexcept { return from_; }
+  [[nodiscard]] const Pose& to() const noexcept { return to_; }
 
   // Appends the section on plane z = z_mm as convex polygons (counter-clockwise, kernel
   // units) to out; returns how many were appended. `scratch` is reused between calls to
