@@ -65,45 +65,53 @@ void refresh_cell(Cell& cell) noexcept {
 
 namespace {
 
-// One Sutherland-Hodgman pass: keeps the part of closed path `in` where inside(p) holds,
-// with the crossing points computed by cross(a, b) (on the boundary line).
-template <class Inside, class Cross>
-void clip_pass(const Path& in, Path& out, Inside inside, Cross cross) {
+// One pass against the half-plane where inside(p) holds: every run of three or more
+// consecutive vertices outside it becomes its first vertex, the projections of its first and
+// last vertex onto the boundary line (project()), and its last vertex. The edges into and
+// out of the run are kept as they are, and what replaces the run lies outside the open
+// half-plane, as the run's own edges do (a half-plane is convex): inside it, the path and
+// every winding number are unchanged, vertex for vertex, with no rounding.
+template <class Inside, class Project>
+void clip_pass(const Path& in, Path& out, Inside inside, Project project) {
   out.clear();
   const std::size_t n = in.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point& a = in[(i + n - 1) % n];
-    const Point& b = in[i];
-    const bool ia = inside(a), ib = inside(b);
-    if (ib) {
-      if (!ia) out.push_back(cross(a, b));
-      out.push_back(b);
-    } else if (ia) {
-      out.push_back(cross(a, b));
+  std::size_t start = n;
+  for (std::size_t i = 0; i < n; ++i)
+    if (inside(in[i])) {
+      start = i;
+      break;
     }
+  if (start == n) return;  // wholly outside: no winding inside
+  for (std::size_t k = 0; k < n;) {
+    const Point& p = in[(start + k) % n];
+    if (inside(p)) {
+      out.push_back(p);
+      ++k;
+      continue;
+    }
+    std::size_t e = k;
+    while (e + 1 < n && !inside(in[(start + e + 1) % n])) ++e;
+    const Point& first = p;
+    const Point& last = in[(start + e) % n];
+    out.push_back(first);
+    if (e - k >= 2) {
+      out.push_back(project(first));
+      out.push_back(project(last));
+    } else if (e > k) {
+      out.push_back(in[(start + k + 1) % n]);
+    }
+    if (e - k >= 2) out.push_back(last);
+    k = e + 1;
   }
-}
-
-// The point of segment a-b at coordinate v of the axis given by member m (the other axis
-// interpolated and rounded to the unit grid).
-Coord lerp_at(Coord a_m, Coord a_o, Coord b_m, Coord b_o, Coord v) noexcept {
-  const double t = static_cast<double>(v - a_m) / static_cast<double>(b_m - a_m);
-  return static_cast<Coord>(std::llround(static_cast<double>(a_o) + t * static_cast<double>(b_o - a_o)));
 }
 
 }  // namespace
 
 void cut_to_rect(const Path& in, const Rect& r, Path& out, Path& tmp) {
-  auto at_x = [](Coord x) {
-    return [x](const Point& a, const Point& b) { return Point{x, lerp_at(a.X, a.Y, b.X, b.Y, x)}; };
-  };
-  auto at_y = [](Coord y) {
-    return [y](const Point& a, const Point& b) { return Point{lerp_at(a.Y, a.X, b.Y, b.X, y), y}; };
-  };
-  clip_pass(in, tmp, [&](const Point& p) { return p.X >= r.x0; }, at_x(r.x0));
-  clip_pass(tmp, out, [&](const Point& p) { return p.X <= r.x1; }, at_x(r.x1));
-  clip_pass(out, tmp, [&](const Point& p) { return p.Y >= r.y0; }, at_y(r.y0));
-  clip_pass(tmp, out, [&](const Point& p) { return p.Y <= r.y1; }, at_y(r.y1));
+  clip_pass(in, tmp, [&](const Point& p) { return p.X > r.x0; }, [&](const Point& p) { return Point{r.x0, p.Y}; });
+  clip_pass(tmp, out, [&](const Point& p) { return p.X < r.x1; }, [&](const Point& p) { return Point{r.x1, p.Y}; });
+  clip_pass(out, tmp, [&](const Point& p) { return p.Y > r.y0; }, [&](const Point& p) { return Point{p.X, r.y0}; });
+  clip_pass(tmp, out, [&](const Point& p) { return p.Y < r.y1; }, [&](const Point& p) { return Point{p.X, r.y1}; });
 }
 
 }  // namespace detail

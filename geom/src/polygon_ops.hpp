@@ -16,11 +16,12 @@ void append_polygons(const ClipperLib::PolyTree& tree, std::vector<Polygon>& out
 // Length of a closed contour [units].
 [[nodiscard]] double perimeter(const Path& p) noexcept;
 
-// The closed path `in` cut to the rectangle r (Sutherland-Hodgman), written to `out`
-// (`tmp` is a scratch buffer). The winding number of every point inside r is kept: each
-// excursion outside r is replaced by a run along r's boundary, and the loop they form lies
-// outside r. So a self-overlapping outline keeps its non-zero region inside r; along r's
-// boundary the result may double back on itself. Allocates only when the buffers grow.
+// The closed path `in` cut down to the rectangle r, written to `out` (`tmp` is a scratch
+// buffer): per side of r, each run of three or more vertices beyond it is replaced by its
+// first and last vertex and their projections onto the side. Inside r the path is unchanged
+// vertex for vertex (no new intersection points, so no rounding), and so is the winding
+// number of every point: the replaced parts lie outside. A self-overlapping outline keeps
+// its non-zero region inside r. Allocates only when the buffers grow.
 void cut_to_rect(const Path& in, const Rect& r, Path& out, Path& tmp);
 
 // Bounding box and cached area of a cell recomputed from its polygons.
