@@ -50,7 +50,17 @@ class SerialSource final : public Source {
 
   void open() override {
     // LibSerial reports a missing device as "Bad file descriptor": say what is wrong first.
-    if (::access(dev_.c_str(), R_OK | W_OK) != 0) throw std::runtime_error("serial:" + dev_ + ": " + std::strerror(errno));
+    if (::access(dev_.c_str(), R_OK | W_OK) != 0) {
+      const int e = errno;
+      std::string hint;  // what to do (issue 19), not just the errno text
+      if (e == ENOENT)
+        hint = ". Is the adapter plugged in? `ls /dev/ttyUSB* /dev/ttyACM*` lists serial devices (`sudo dmesg | tail` "
+               "names a new one). Without a machine, feed a pseudo-terminal: `build/tools/feeders/lbr-feed-serial "
+               "--pty-link /tmp/lbr-pty --profile PROFILE`, then --source serial:/tmp/lbr-pty with the same profile";
+      else if (e == EACCES)
+        hint = ". Join the group that owns it (usually dialout: `sudo usermod -aG dialout $USER`, then log in again)";
+      throw std::runtime_error("serial:" + dev_ + ": " + std::strerror(e) + hint);
+    }
     termios settings{};
     int fd = -1;
     try {
