@@ -153,18 +153,9 @@ serial_pty() {  # README: serial:/tmp/lbr-pty (the feeder line's pty): runs unti
 }
 rs274() {  # CHECKS...: as written where LinuxCNC's rs274 is on PATH
   if ! command -v rs274 >/dev/null; then skip "no rs274 on PATH (Debian package linuxcnc-uspace)"; return 0; fi
-  # Known defect: --interpreter rs274 with a program path without a folder (part.ngc) fails
-  # in nc/src/rs274.cpp (std::filesystem::absolute of its empty parent_path()). Until it is
-  # fixed the line runs as ./part.ngc; once it works as written this check fails: remove it.
-  local bug="cannot make absolute path"
+  # (Regression: a program path without a folder used to fail in nc/src/rs274.cpp with
+  # "cannot make absolute path"; the line runs as written.)
   N_RUN=$((N_RUN + 1)); sh_line "$LINE"
-  if [ "$RC" -ne 0 ] && grep -q "$bug" "$LOG"; then
-    echo "  KNOWN DEFECT: rs274 with a bare program name ('$bug'); run as ./part.ngc"
-    N_RUN=$((N_RUN - 1)) N_ADAPTED=$((N_ADAPTED + 1))
-    sh_line "${LINE/--program part.ngc/--program ./part.ngc}"
-  elif [ "$RC" -eq 0 ]; then
-    fail "the rs274 bare-name defect is fixed: drop the ./part.ngc work-around in tests/cli_readme.sh"
-  fi
   rc 0 && for c in "$@"; do eval "$c" || return 1; done
 }
 genbench() {  # README: --out bench/programs; here a temporary folder: every bench/programs/*.ngc written

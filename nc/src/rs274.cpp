@@ -341,7 +341,9 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
   }
   write("program.ngc", prog);
   // Subroutines: the program's directory, then [nc] subroutine_path (as the built-in interpreter).
-  std::string sub_path = std::filesystem::absolute(std::filesystem::path(program_path).parent_path()).string();
+  // (A bare file name has an empty parent: the working directory.)
+  const std::filesystem::path program_dir = std::filesystem::path(program_path).parent_path();
+  std::string sub_path = std::filesystem::absolute(program_dir.empty() ? std::filesystem::path(".") : program_dir).string();
   for (const std::string& d : options.subroutine_path) sub_path += ":" + std::filesystem::absolute(d).string();
   std::string ini = "[RS274NGC]\nPARAMETER_FILE=rs274.var\nSUBROUTINE_PATH=" + sub_path + "\n";
   write("rs274.ini", ini);
