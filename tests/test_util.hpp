@@ -1,6 +1,7 @@
 // Helpers shared by the kernel tests: stock, tools and single cuts in a line.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -55,5 +56,20 @@ inline void cut_path(geom::LbrSolid& s, const geom::CutterShape& c, const std::v
 }
 
 inline double removed(const geom::LbrSolid& s) { return s.initial_volume_mm3() - s.volume_mm3(); }
+
+// Pocket 30 x 20 (x 15..45, y 10..30), depth 4, for a Ø6 flat: tool centre inside
+// [18, 42] x [13, 27], zig-zag at 2.5 mm stepover from (18, 13, -4), then the finishing
+// loop; appended to `p`. Removed volume: kPocketVolume.
+inline void append_pocket_path(std::vector<geom::Vec3>& p) {
+  bool right = true;
+  for (double y = 13; y <= 27 + 1e-9; y += 2.5) {
+    const double yy = std::min(y, 27.0);
+    p.push_back({right ? 18.0 : 42.0, yy, -4});
+    p.push_back({right ? 42.0 : 18.0, yy, -4});
+    right = !right;
+  }
+  for (const geom::Vec3& q : {geom::Vec3{42, 27, -4}, {42, 13, -4}, {18, 13, -4}, {18, 27, -4}, {42, 27, -4}}) p.push_back(q);
+}
+inline constexpr double kPocketVolume = (30.0 * 20.0 - (4.0 - kPi) * 9.0) * 4.0;
 
 }  // namespace lbr::test
