@@ -459,16 +459,22 @@ bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) co
   ramp_hull(sc, n, grow, sc.unit_circle(n));
   // The caps are the hull's runs of start-disk and end-disk vertices; each must be one run.
   const std::size_t m = sc.hull.size();
-  auto run_of = [&](std::uint8_t role, std::size_t& first, std::size_t& last) {
-    int starts = 0;
-    for (std::size_t i = 0; i < m; ++i)
-      if (sc.hull_role[i] == role && sc.hull_role[(i + m - 1) % m] != role) {
-        ++starts;
-        first = i;
-      }
-    if (starts != 1) return false;
-    last = first;
-    while (sc.hull_role[(last + 1) % m] == role) last = (last + 1) % m;
+  // One pass: where each role's run starts and ends (a role with two runs, or none, fails).
+  const std::uint8_t* role = sc.hull_role.data();
+  std::size_t first[3] = {0, 0, 0}, last[3] = {0, 0, 0};
+  int starts[3] = {0, 0, 0}, ends[3] = {0, 0, 0};
+  for (std::size_t i = 0, prev = m - 1; i < m; prev = i++) {
+    if (role[i] != role[prev]) {
+      ++starts[role[i]];
+      first[role[i]] = i;
+      ++ends[role[prev]];
+      last[role[prev]] = prev;
+    }
+  }
+  auto run_of = [&](std::uint8_t r, std::size_t& f, std::size_t& l) {
+    if (starts[r] != 1 || ends[r] != 1) return false;
+    f = first[r];
+    l = last[r];
     return true;
   };
   std::size_t s0 = 0, s1 = 0, e0 = 0, e1 = 0;
@@ -477,8 +483,11 @@ bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) co
   out.back_r = sc.hull_grid[s1];
   out.front_r = sc.hull_grid[e0];
   out.front_l = sc.hull_grid[e1];
-  for (std::size_t i = (s1 + 1) % m; i != e0; i = (i + 1) % m) out.right.push_back(sc.hull[i]);
-  for (std::size_t i = (e1 + 1) % m; i != s0; i = (i + 1) % m) out.left.push_back(sc.hull[i]);
+  auto copy_between = [&](std::size_t after, std::size_t before, std::vector<P2>& to) {
+    for (std::size_t i = after + 1 == m ? 0 : after + 1; i != before; i = i + 1 == m ? 0 : i + 1) to.push_back(sc.hull[i]);
+  };
+  copy_between(s1, e0, out.right);
+  copy_between(e1, s0, out.left);
   return true;
 }
 
