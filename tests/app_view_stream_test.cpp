@@ -62,7 +62,10 @@ void expect_animation_matches_batch(const StreamCase& run, double chord_rel) {
   const double animated = animated_removed_mm3(run, batches);
   const double sampled = batch_removed_mm3(run, true);
   const double plain = batch_removed_mm3(run, false);
-  EXPECT_GT(batches, 3u) << "the stream should arrive in several batches";
+  // Paced at 500x real time: how many batches the stream arrives in depends on the build's
+  // speed (a sanitizer build gathers more samples per batch; 3 measured there), so only
+  // "more than one" is asserted: the animation streamed rather than cut all at once.
+  EXPECT_GE(batches, 2u) << "the stream should arrive in several batches";
   ASSERT_GT(sampled, 0.0);
   // Same sweeps, other batches: the kernel merges collinear sweeps within a batch, so other
   // batch boundaries round the sections differently (measured 4.9e-6 relative on mill5,

@@ -414,7 +414,18 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
   for (int k = 0; k < n; ++k) {
     const double ck = uc[k].x, sk = uc[k].y;
     const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
-    const int i0 = m == 1 ? 0 : piece(cphi + sphi * T), i1 = m == 1 ? 0 : piece(cphi - sphi * T);
+    const double hp = cphi + sphi * T, hm = cphi - sphi * T;
+    // Inside a cap one disk wins the whole wedge: piece(h) is m-1 exactly when br[m-1] <= h
+    // and 0 exactly when h < br[1], so the two searches are needed only between.
+    int i0 = 0, i1 = 0;
+    if (m == 1 || (hp < br[1] && hm < br[1])) {
+      i0 = i1 = 0;
+    } else if (hp >= br[m - 1] && hm >= br[m - 1]) {
+      i0 = i1 = m - 1;
+    } else {
+      i0 = piece(hp);
+      i1 = piece(hm);
+    }
     const int step = i1 >= i0 ? 1 : -1;
     for (int i = i0;; i += step) {
       const auto& d = disks[env[i]];
