@@ -350,7 +350,6 @@ void LbrSolid::prepare_shared(std::span<const SweepRef> batch, SubtractShared& s
   sh.sweeps.clear();
   sh.sweep_id.clear();
   sh.runs.clear();
-  sh.run_tip_min.clear();
   bool run_open = false;  // the last item pushed is a sweep that the next one may continue
   sh.lathe.clear();
   sh.lathe_id.clear();
@@ -399,14 +398,10 @@ void LbrSolid::prepare_shared(std::span<const SweepRef> batch, SubtractShared& s
     sh.sweep_id.push_back(s.id);
     const auto si = static_cast<std::uint32_t>(sh.sweeps.size() - 1);
     const bool vertical = sh.sweeps.back().vertical();
-    const double tip_min = std::min(s.from.tip.z, s.to.tip.z);
-    if (vertical && run_open && merged[i - 1].shape == s.shape && merged[i - 1].to.tip == s.from.tip) {
+    if (vertical && run_open && merged[i - 1].shape == s.shape && merged[i - 1].to.tip == s.from.tip)
       sh.runs.back().second = si + 1;
-      sh.run_tip_min.back() = std::min(sh.run_tip_min.back(), tip_min);
-    } else {
+    else
       sh.runs.emplace_back(si, si + 1);  // (a tilted move is a run of one: its section as it is)
-      sh.run_tip_min.push_back(tip_min);
-    }
     run_open = vertical;
     zlo = std::min(zlo, sh.sweeps.back().z_min());
     zhi = std::max(zhi, sh.sweeps.back().z_max());
@@ -641,7 +636,7 @@ void LbrSolid::build_level(int level, const SubtractShared& sh, SubtractWorkspac
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
-  for (std::size_t r = 0; r < sh.runs.size(); ++r) build_run_sections(zc, r, sh, ws, ls, stats);
+  for (const auto& run : sh.runs) build_run_sections(zc, run, sh, ws, ls, stats);
   ls.chain.assign(ls.paths.size(), kNoChain);
   // Chains: one entry for the whole offset (outer contours and holes); a clip adds its
   // piece cut to the region (SubtractShared::Offset).
@@ -698,9 +693,8 @@ void LbrSolid::build_level(int level, const SubtractShared& sh, SubtractWorkspac
 // The sections of one run of sweeps on plane zc: consecutive moves whose sections share
 // their joint disk become one outline (chain_outline.hpp); the others are emitted one by
 // one, trimmed where the previous vertical section covers them (trim_covered()).
-void LbrSolid::build_run_sections(double zc, std::size_t run_index, const SubtractShared& sh, SubtractWorkspace& ws,
-                                  LevelSections& ls, SubtractStats& stats) const {
-  const std::pair<std::uint32_t, std::uint32_t> run = sh.runs[run_index];
+void LbrSolid::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
+                                  SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const {
   Capsule prev_core;  // inside the last single vertical section of this run (trim_covered())
   auto push_boxes = [&](std::size_t before, MoveId id) {
     for (std::size_t k = before; k < ls.paths.size(); ++k) {
@@ -718,12 +712,9 @@ void LbrSolid::build_run_sections(double zc, std::size_t run_index, const Subtra
     }
     // Joined outline from si, when si and at least the next move share their joint disk.
     if (run.second - si >= 2) {
-      // One angle grid along the run: the largest radius the run can have on this level
-      // (at its lowest tip) sets it. Even, so that a stadium's caps are exact half turns
-      // (chain_outline.cpp, chord_is_covered()).
-      const CutterShape& cs = sw.shape();
-      const double r_max = cs.radius_at(std::clamp(zc - sh.run_tip_min[run_index], 0.0, cs.height()));
-      const int grid = (Sweep::circle_segments(r_max, cs.chord_tol_mm) + 1) / 2 * 2;
+      // One angle grid along the run: the tool's full radius sets it. Even, so that a
+      // stadium's caps are exact half turns (chain_outline.cpp, chord_is_covered()).
+      const int grid = (Sweep::circle_segments(sw.shape().radius(), sw.shape().chord_tol_mm) + 1) / 2 * 2;
       if (ws.caps.size() < run.second - si) ws.caps.resize(run.second - si);
       std::size_t count = 0;
       while (si + count < run.second && sh.sweeps[si + count].section_caps(zc, grid, ws.scratch, ws.caps[count]) &&

@@ -126,7 +126,6 @@ struct SubtractShared {
   // Runs of consecutive sweeps [first, last) of one tool with a vertical axis along a
   // continuous path: on each level their sections are joined into outlines where they can.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
-  std::vector<double> run_tip_min;  // per run: its lowest tip height [mm] (the largest radius per level)
   std::vector<LatheSweep> lathe;  // one per merged turning move
   std::vector<MoveId> lathe_id;
   // Runs of at least three consecutive horizontal moves of one tool with a vertical axis at
@@ -292,8 +291,8 @@ class LbrSolid {
                    SubtractStats& stats) const;
   void trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
                    LevelSections& ls, SubtractStats& stats) const;
-  void build_run_sections(double zc, std::size_t run_index, const SubtractShared& sh, SubtractWorkspace& ws,
-                          LevelSections& ls, SubtractStats& stats) const;
+  void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
+                          SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   const Paths& offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const;
   bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                  SubtractStats& stats);
