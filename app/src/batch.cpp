@@ -71,6 +71,26 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
 
 }  // namespace
 
+std::vector<std::string> toolpath_warnings(const nc::Toolpath& path) {
+  std::vector<std::string> out;
+  const std::string& name = path.source;
+  if (path.segments.empty()) {
+    out.push_back(name + ": the program holds no moves; nothing is cut");
+    return out;
+  }
+  std::size_t untooled = 0;
+  int first_line = 0;
+  for (const nc::Segment& s : path.segments)
+    if (s.kind == nc::SegmentKind::Feed && s.tool == 0) {
+      if (untooled++ == 0) first_line = s.line;
+    }
+  if (untooled > 0)
+    out.push_back(name + ":" + std::to_string(first_line) + ": " + std::to_string(untooled) +
+                  " feed moves run with no tool loaded (tool 0) and cut nothing; load one with T.. M6, "
+                  "or set [nc] start_tool in the profile when the spindle already holds a tool");
+  return out;
+}
+
 double machining_time_s(const Profile& profile, const nc::Toolpath& path) {
   double t = 0.0;
   nc::AxisVector pos = path.start;

@@ -221,6 +221,7 @@ int run_batch_command(const BatchOptions& o) {
       o.program.empty() ? app::demo_toolpath() : app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   const std::string program = o.program.empty() ? path.source : o.program;
   spdlog::info("program {} ({} segments), profile {}", program, path.segments.size(), profile.source);
+  for (const std::string& w : app::toolpath_warnings(path)) spdlog::warn("{}", w);
   // G-code programs and sampled runs take the emulator's time (acceleration, axis limits).
   const bool emulated = o.sampled || (!o.program.empty() && app::is_gcode_path(o.program));
   double emulated_time_s = 0.0;

@@ -29,6 +29,12 @@ struct BatchResult {
 // Progress callback: fraction done in [0, 1].
 using Progress = std::function<void(double)>;
 
+// What a user should hear about a toolpath before it runs: an empty program, and feed
+// moves that run with no tool loaded (tool 0 removes nothing; a program that never calls
+// M6 cuts nothing unless the profile's [nc] start_tool says which tool the spindle holds).
+// One message each, empty when there is nothing to say.
+std::vector<std::string> toolpath_warnings(const nc::Toolpath& path);
+
 // Runs `path` on the stock of `profile`. Throws std::runtime_error naming the source line
 // when the path uses a tool the profile does not define. Segments with tool 0 (empty
 // spindle) remove nothing.
