@@ -63,6 +63,11 @@ bool same_polygons(const Cell& a, const Cell& b) noexcept {
   return true;
 }
 
+// b lies wholly inside a.
+bool contains(const Rect& a, const Rect& b) noexcept {
+  return b.x0 >= a.x0 && b.x1 <= a.x1 && b.y0 >= a.y0 && b.y1 <= a.y1;
+}
+
 Path rect_path(const Rect& r) {
   return Path{{r.x0, r.y0}, {r.x1, r.y0}, {r.x1, r.y1}, {r.x0, r.y1}};
 }
@@ -185,6 +190,12 @@ double LbrSolid::level_z_mm(int level) const noexcept {
 int LbrSolid::level_at(double z_mm) const noexcept {
   const double f = std::floor((z_mm - z0_) / spec_.level_spacing_mm);
   return static_cast<int>(std::clamp(f, 0.0, static_cast<double>(levels_ - 1)));
+}
+
+Rect LbrSolid::grown_region_rect(int region) const noexcept {
+  const Rect rr = region_rect(region);
+  const Coord g = static_cast<Coord>(kUnitsPerMm);
+  return Rect{rr.x0 - g, rr.y0 - g, rr.x1 + g, rr.y1 + g};
 }
 
 Rect LbrSolid::region_rect(int region) const noexcept {
@@ -759,7 +770,9 @@ void LbrSolid::build_run_sections(double zc, std::pair<std::uint32_t, std::uint3
 
 // A tilted move's sections (one per sub-step) on a level overlap the previous sub-step's and
 // the previous tilted move's as much as vertical ones do: each is trimmed by the previous
-// one, as it was before its own trimming (convex; trim_covered() with a polygon).
+// one as it was before its own trimming (convex; trim_covered() with a polygon). Any
+// untrimmed section of this level is a valid cover (what trimming took from it lies in its
+// own cover, which is removed in the same difference); the previous move's is the useful one.
 void LbrSolid::trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
                            LevelSections& ls, SubtractStats& stats) const {
   const Sweep& sw = sh.sweeps[si];
@@ -775,7 +788,8 @@ void LbrSolid::trim_tilted(std::uint32_t si, std::size_t before, const SubtractS
       if (!keep || ls.paths[k].size() != vertices) ++stats.sections_trimmed;
     }
     ws.prev_tilted.swap(ws.tilted_next);
-    covered = true;
+    ws.prev_tilted_valid = covered = true;
+    ws.prev_tilted_sweep = si;
     if (!keep) {
       ws.scratch.spare.push_back(std::move(ls.paths[k]));
       continue;
@@ -784,8 +798,6 @@ void LbrSolid::trim_tilted(std::uint32_t si, std::size_t before, const SubtractS
     ++w;
   }
   ls.paths.resize(w);
-  ws.prev_tilted_valid = w > before || covered;
-  ws.prev_tilted_sweep = si;
 }
 
 // The chain offset `o` cut to `region` (grown by 1 mm); the first thread that needs a piece
@@ -797,11 +809,8 @@ const Paths& LbrSolid::offset_piece(SubtractShared& sh, std::uint32_t o, int reg
   // A cell can touch the box on its edge from the region beside the box's first one: the
   // offset covers none of its area there.
   if (ix < off.ix0 || ix > off.ix1 || iy < off.iy0 || iy > off.iy1) return kNone;
-  Rect rr = region_rect(region);
-  const Coord grow = static_cast<Coord>(kUnitsPerMm);
-  rr = Rect{rr.x0 - grow, rr.y0 - grow, rr.x1 + grow, rr.y1 + grow};
-  if (off.box.x0 >= rr.x0 && off.box.x1 <= rr.x1 && off.box.y0 >= rr.y0 && off.box.y1 <= rr.y1)
-    return off.paths;  // wholly inside: nothing to cut
+  const Rect rr = grown_region_rect(region);
+  if (contains(rr, off.box)) return off.paths;  // wholly inside: nothing to cut
   const std::size_t i = static_cast<std::size_t>((iy - off.iy0) * (off.ix1 - off.ix0 + 1) + (ix - off.ix0));
   std::atomic_ref<std::uint8_t> state(off.state[i]);
   std::uint8_t s = state.load(std::memory_order_acquire);
@@ -820,13 +829,11 @@ const Paths& LbrSolid::offset_piece(SubtractShared& sh, std::uint32_t o, int reg
   return off.cut[i];
 }
 
-// Clips one cell with the level's sections; true when the cell changed.
-bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
-                         SubtractStats& stats) {
-  const std::size_t ci = static_cast<std::size_t>(region) * levels_ + level;
-  Cell& cell = cells_[ci];
-  if (!cell.bbox.intersects(ls.all)) return false;
-  ++stats.cells_tested;
+namespace {
+
+// The sections whose box meets the cell's content (ws.selected) and the cell's polygons
+// whose box meets those sections (ws.touched); false when either is empty.
+bool select_for_cell(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws) {
   ws.selected.clear();
   Rect clipbox;
   for (std::uint32_t k = 0; k < ls.paths.size(); ++k) {
@@ -839,96 +846,64 @@ bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, Subtrac
   ws.touched.clear();
   for (std::uint32_t p = 0; p < cell.polys.size(); ++p)
     if (cell.polys[p].bbox.intersects(clipbox)) ws.touched.push_back(p);
-  if (ws.touched.empty()) return false;
+  return !ws.touched.empty();
+}
 
-  // Sections in the air: when no edge of the material comes near a section's box, the box
-  // lies wholly inside or wholly outside the material, and one point decides which. A
-  // section outside removes nothing and leaves the clip (the shank of a finishing tool over
-  // already cleared levels); when none is left, nothing changes.
-  {
-    std::size_t kept = 0;
-    for (std::uint32_t k : ws.selected) {
-      const Rect& b = ls.box[k];
-      bool near = false, inside = false;
-      const Point centre{b.x0 + (b.x1 - b.x0) / 2, b.y0 + (b.y1 - b.y0) / 2};
-      for (std::uint32_t p : ws.touched) {
-        const Polygon& poly = cell.polys[p];
-        if (!poly.bbox.intersects(b)) continue;
-        near = edge_near(poly.outer.pts, b);
-        for (std::size_t h = 0; !near && h < poly.holes.size(); ++h) near = edge_near(poly.holes[h].pts, b);
-        if (near) break;
-        if (ClipperLib::PointInPolygon(centre, poly.outer.pts) != 0) {
-          inside = true;
-          for (const Contour& h : poly.holes)
-            if (ClipperLib::PointInPolygon(centre, h.pts) != 0) inside = false;
-          if (inside) break;
-        }
-      }
-      if (near || inside) ws.selected[kept++] = k;
-      else ++stats.sections_in_air;
-    }
-    ws.selected.resize(kept);
-    if (ws.selected.empty()) return false;
-  }
-
-  ClipperLib::Clipper& c = ws.clipper;
-  c.Clear();
-  c.StrictlySimple(spec_.strictly_simple);
-  for (std::uint32_t p : ws.touched) {
-    c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
-    for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
-  }
-  // Long sections that reach well beyond the region (a joined outline runs along a whole
-  // pass) are cut to the region grown by 1 mm first: the clip then carries only the nearby
-  // edges. The cut keeps the winding inside the grown region, where the cell lies.
-  const Rect grown = [&] {
-    const Rect rr = region_rect(region);
-    const Coord g = static_cast<Coord>(kUnitsPerMm);
-    return Rect{rr.x0 - g, rr.y0 - g, rr.x1 + g, rr.y1 + g};
-  }();
+// Sections in the air: when no edge of the material comes near a section's box, the box
+// lies wholly inside or wholly outside the material, and one point decides which. A
+// section outside removes nothing and leaves the clip (the shank of a finishing tool over
+// already cleared levels). False when none is left: nothing changes.
+bool drop_sections_in_air(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws, SubtractStats& stats) {
+  std::size_t kept = 0;
   for (std::uint32_t k : ws.selected) {
-    if (ls.chain[k] == kNoChain) {
-      const Rect& b = ls.box[k];
-      const bool inside = b.x0 >= grown.x0 && b.x1 <= grown.x1 && b.y0 >= grown.y0 && b.y1 <= grown.y1;
-      if (inside || ls.paths[k].size() < kCutSectionVertices) {
-        c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
-      } else {
-        detail::cut_to_rect(ls.paths[k], grown, ws.cut, ws.cut_tmp);
-        if (ws.cut.size() >= 3) c.AddPath(ws.cut, ClipperLib::ptClip, true);
-      }
-    } else {
-      c.AddPaths(offset_piece(sh, ls.chain[k], region, ws), ClipperLib::ptClip, true);
-    }
-  }
-  ws.tree.Clear();
-  c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-  ++stats.cells_clipped;
-  ws.fresh.clear();
-  detail::append_polygons(ws.tree, ws.fresh);
-
-  // A difference that removes no more than the rounding of intersection points to the
-  // unit grid can account for (half a unit along the touched perimeter) is noise, e.g.
-  // a second pass along the same path: keep the old polygons, vertex for vertex.
-  {
-    double before = 0.0, after = 0.0, perimeter = 0.0;
+    const Rect& b = ls.box[k];
+    bool near = false, inside = false;
+    const Point centre{b.x0 + (b.x1 - b.x0) / 2, b.y0 + (b.y1 - b.y0) / 2};
     for (std::uint32_t p : ws.touched) {
-      const Polygon& old = cell.polys[p];
-      before += ClipperLib::Area(old.outer.pts);
-      perimeter += detail::perimeter(old.outer.pts);
-      for (const Contour& h : old.holes) {
-        before += ClipperLib::Area(h.pts);
-        perimeter += detail::perimeter(h.pts);
+      const Polygon& poly = cell.polys[p];
+      if (!poly.bbox.intersects(b)) continue;
+      near = edge_near(poly.outer.pts, b);
+      for (std::size_t h = 0; !near && h < poly.holes.size(); ++h) near = edge_near(poly.holes[h].pts, b);
+      if (near) break;
+      if (ClipperLib::PointInPolygon(centre, poly.outer.pts) != 0) {
+        inside = true;
+        for (const Contour& h : poly.holes)
+          if (ClipperLib::PointInPolygon(centre, h.pts) != 0) inside = false;
+        if (inside) break;
       }
     }
-    for (const Polygon& poly : ws.fresh) {
-      after += ClipperLib::Area(poly.outer.pts);
-      for (const Contour& h : poly.holes) after += ClipperLib::Area(h.pts);
-    }
-    if (before - after <= 0.5 * perimeter) return false;
+    if (near || inside) ws.selected[kept++] = k;
+    else ++stats.sections_in_air;
   }
+  ws.selected.resize(kept);
+  return kept > 0;
+}
 
-  // Carry the move id over to contours that came out unchanged; a new or changed
-  // contour takes the latest move among the sections that overlap it.
+// A difference that removes no more than the rounding of intersection points to the unit
+// grid can account for (half a unit along the touched perimeter) is noise, e.g. a second
+// pass along the same path: the caller keeps the old polygons, vertex for vertex.
+bool removes_only_noise(const Cell& cell, const SubtractWorkspace& ws) {
+  double before = 0.0, after = 0.0, perimeter = 0.0;
+  for (std::uint32_t p : ws.touched) {
+    const Polygon& old = cell.polys[p];
+    before += ClipperLib::Area(old.outer.pts);
+    perimeter += detail::perimeter(old.outer.pts);
+    for (const Contour& h : old.holes) {
+      before += ClipperLib::Area(h.pts);
+      perimeter += detail::perimeter(h.pts);
+    }
+  }
+  for (const Polygon& poly : ws.fresh) {
+    after += ClipperLib::Area(poly.outer.pts);
+    for (const Contour& h : poly.holes) after += ClipperLib::Area(h.pts);
+  }
+  return before - after <= 0.5 * perimeter;
+}
+
+// Carries the move id over to the contours of ws.fresh that came out unchanged; a new or
+// changed contour takes the latest move among the sections that overlap it. True when
+// some contour changed.
+bool inherit_move_ids(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws) {
   bool changed = ws.fresh.size() != ws.touched.size();
   auto inherit = [&](Contour& out, const Rect& box) {
     for (std::uint32_t p : ws.touched) {
@@ -956,9 +931,11 @@ bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, Subtrac
     inherit(poly.outer, poly.bbox);
     for (Contour& h : poly.holes) inherit(h, bounds_of(h.pts));
   }
-  if (!changed) return false;
+  return changed;
+}
 
-  // Keep the untouched polygons, then append the new ones.
+// The cell's polygons with the touched ones replaced by ws.fresh (untouched first).
+void replace_touched(Cell& cell, SubtractWorkspace& ws) {
   ws.kept.clear();
   std::size_t t = 0;
   for (std::uint32_t p = 0; p < cell.polys.size(); ++p) {
@@ -970,6 +947,54 @@ bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, Subtrac
   }
   for (Polygon& poly : ws.fresh) ws.kept.push_back(std::move(poly));
   cell.polys.swap(ws.kept);
+}
+
+}  // namespace
+
+// The selected sections as clip paths. A chain enters as its offset's piece for the
+// region; a long section that reaches well beyond the region (a joined outline runs along
+// a whole pass) is cut down to the region grown by 1 mm first, so that the clip carries
+// only the nearby edges (the cut keeps the path inside the grown region, where the cell lies).
+void LbrSolid::add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const {
+  ClipperLib::Clipper& c = ws.clipper;
+  const Rect grown = grown_region_rect(region);
+  for (std::uint32_t k : ws.selected) {
+    if (ls.chain[k] != kNoChain) {
+      c.AddPaths(offset_piece(sh, ls.chain[k], region, ws), ClipperLib::ptClip, true);
+    } else if (contains(grown, ls.box[k]) || ls.paths[k].size() < kCutSectionVertices) {
+      c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
+    } else {
+      detail::cut_to_rect(ls.paths[k], grown, ws.cut, ws.cut_tmp);
+      if (ws.cut.size() >= 3) c.AddPath(ws.cut, ClipperLib::ptClip, true);
+    }
+  }
+}
+
+// Clips one cell with the level's sections; true when the cell changed.
+bool LbrSolid::clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
+                         SubtractStats& stats) {
+  const std::size_t ci = static_cast<std::size_t>(region) * levels_ + level;
+  Cell& cell = cells_[ci];
+  if (!cell.bbox.intersects(ls.all)) return false;
+  ++stats.cells_tested;
+  if (!select_for_cell(cell, ls, ws) || !drop_sections_in_air(cell, ls, ws, stats)) return false;
+
+  ClipperLib::Clipper& c = ws.clipper;
+  c.Clear();
+  c.StrictlySimple(spec_.strictly_simple);
+  for (std::uint32_t p : ws.touched) {
+    c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
+    for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
+  }
+  add_clip_paths(region, ls, sh, ws);
+  ws.tree.Clear();
+  c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  ++stats.cells_clipped;
+  ws.fresh.clear();
+  detail::append_polygons(ws.tree, ws.fresh);
+  if (removes_only_noise(cell, ws) || !inherit_move_ids(cell, ls, ws)) return false;
+
+  replace_touched(cell, ws);
   detail::refresh_cell(cell);
   cell.last_cut = 0;
   for (std::uint32_t k : ws.selected) cell.last_cut = std::max(cell.last_cut, ls.id[k]);

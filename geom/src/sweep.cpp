@@ -452,8 +452,6 @@ bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) co
   out.right.clear();
   out.left.clear();
   const bool uniform = std::all_of(ds.begin(), ds.end(), [&](const auto& d) { return d.r == ds.front().r; });
-  out.uniform = uniform;
-  out.length = std::hypot(dx, dy);
   if (uniform) {
     // Equal disks on one grid: the hull is the far half of each (section_vertical()), the
     // sides are single edges between the grid vertices normal to the motion.

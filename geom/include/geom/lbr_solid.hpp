@@ -294,6 +294,9 @@ class LbrSolid {
   void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
                           SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   const Paths& offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const;
+  // The region's rectangle grown by 1 mm: what a clip of its cells needs of a long section.
+  [[nodiscard]] Rect grown_region_rect(int region) const noexcept;
+  void add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const;
   bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                  SubtractStats& stats);
 

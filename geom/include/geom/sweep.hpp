@@ -83,8 +83,6 @@ struct MoveCaps {
   double rho0 = 0.0, rho1 = 0.0;
   int back_l = 0, back_r = 0, front_r = 0, front_l = 0;
   std::vector<SectionScratch::P2> right, left;
-  bool uniform = false;  // two equal disks: the section is a stadium (no side vertices)
-  double length = 0.0;   // of the motion in XY [mm]
 };
 
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
