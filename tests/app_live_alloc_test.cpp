@@ -18,6 +18,7 @@
 #include <new>
 #include <vector>
 
+#include "alloc_counter.hpp"
 #include "app/profile.hpp"
 #include "hal/serial_codec.hpp"
 #include "hal/validate.hpp"
@@ -26,30 +27,12 @@
 #include "motion/sample_stream.hpp"
 #include "motion/tool_table.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t n, std::align_val_t a) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  const std::size_t al = static_cast<std::size_t>(a);
-  if (void* p = std::aligned_alloc(al, (n + al - 1) / al * al)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 namespace {
 
 using namespace lbr;
 
-long allocations() { return g_allocations.load(std::memory_order_relaxed); }
+using test::allocations;
 
 hal::AxisSample sample(std::uint64_t seq, double x, double y, double z, int tool = 1) {
   hal::AxisSample s;

@@ -4,5 +4,5 @@ lbr_test(app_view_stream_test app_view_stream_test.cpp)
 target_compile_definitions(app_view_stream_test PRIVATE LBR_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # Real-time contracts: allocations on the HAL path, the motion stream and a geometry tick
 # (white-box: the live pipeline's private headers in app/src/live/).
-lbr_test(app_live_alloc_test app_live_alloc_test.cpp)
+lbr_test(app_live_alloc_test app_live_alloc_test.cpp alloc_counter.cpp)
 target_include_directories(app_live_alloc_test PRIVATE ${PROJECT_SOURCE_DIR}/app/src)

@@ -10,19 +10,9 @@
 
 #include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
+#include "alloc_counter.hpp"
 #include "nc_test_util.hpp"
 
-// Counts heap allocations so that the test can prove next() does not allocate.
-namespace {
-std::atomic<long> g_allocations{0};
-}
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -217,9 +207,9 @@ TEST_F(EmulatorProgram, NextDoesNotAllocate) {
   Emulator em(path_, lim_);
   Sample s;
   std::uint64_t n = 0;
-  const long before = g_allocations.load();
+  const long before = lbr::test::allocations();
   while (em.next(s)) ++n;
-  const long after = g_allocations.load();
+  const long after = lbr::test::allocations();
   EXPECT_EQ(after, before);
   EXPECT_EQ(n, em.sample_count());
 }

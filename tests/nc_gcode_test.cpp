@@ -23,16 +23,8 @@ using lbr::test::program_file;
 
 constexpr double kEps = 1e-9;
 
-Toolpath run(const std::string& text, GcodeOptions o = {}) { return interpret_gcode(text, "t.ngc", o); }
-
-std::string error_of(const std::string& text, GcodeOptions o = {}) {
-  try {
-    (void)interpret_gcode(text, "t.ngc", o);
-  } catch (const ParseError& e) {
-    return e.what();
-  }
-  return "<no error>";
-}
+using lbr::test::error_of;
+using lbr::test::run;
 
 void expect_at(const AxisVector& p, double x, double y, double z) {
   EXPECT_NEAR(p[X], x, kEps);

@@ -12,21 +12,14 @@
 
 #include "nc/gcode.hpp"
 #include "nc/rs274.hpp"
+#include "nc_test_util.hpp"
 
 namespace {
 
 using namespace lbr::nc;
 
-Toolpath run(const std::string& text, GcodeOptions o = {}) { return interpret_gcode(text, "t.ngc", o); }
-
-std::string error_of(const std::string& text, GcodeOptions o = {}) {
-  try {
-    (void)interpret_gcode(text, "t.ngc", o);
-  } catch (const ParseError& e) {
-    return e.what();
-  }
-  return "<no error>";
-}
+using lbr::test::error_of;
+using lbr::test::run;
 
 // Feed/rapid end points only (no dwell or tool change).
 std::vector<AxisVector> ends(const Toolpath& tp) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "nc/gcode.hpp"
 #include "nc/toolpath.hpp"
 
 #ifndef LBR_SOURCE_DIR
@@ -30,6 +31,19 @@ inline double axis_dist_to_segment(const nc::AxisVector& p, const nc::AxisVector
     d2 += q * q;
   }
   return std::sqrt(d2);
+}
+
+// The built-in interpreter on a program text (named t.ngc in messages).
+inline nc::Toolpath run(const std::string& text, nc::GcodeOptions o = {}) { return nc::interpret_gcode(text, "t.ngc", o); }
+
+// The interpreter's error message for a program text, or "<no error>".
+inline std::string error_of(const std::string& text, nc::GcodeOptions o = {}) {
+  try {
+    (void)nc::interpret_gcode(text, "t.ngc", o);
+  } catch (const nc::ParseError& e) {
+    return e.what();
+  }
+  return "<no error>";
 }
 
 }  // namespace lbr::test
