@@ -48,6 +48,9 @@ if ((${#checked[@]} == 0 && ${#reported[@]} == 0)); then
   echo "usage: tools/check-function-length.sh [--max N] [--report DIR]... DIR..." >&2
   exit 2
 fi
+for d in "${checked[@]}" "${reported[@]}"; do
+  [[ -e "$d" ]] || { echo "check-function-length.sh: no such file or folder: $d" >&2; exit 2; }
+done
 [[ "$max" =~ ^[0-9]+$ ]] || { echo "check-function-length.sh: --max expects a number, got '$max'" >&2; exit 2; }
 
 # Prints the functions over the limit in the files named on stdin (one path a line).

@@ -115,6 +115,7 @@ class PlaneBuilder {
   std::vector<Seg> segs_;
   std::array<std::vector<std::vector<std::vector<Point>>>, 2> splits_;  // per side, contour, edge
   std::vector<Point> extra_, feed_;  // vertices Clipper made; those of the previous attempt
+  std::vector<const Path*> ring_ptrs_;  // the rings of the cap being triangulated
 };
 
 void PlaneBuilder::run() {
@@ -469,10 +470,10 @@ void PlaneBuilder::emit_cap(int dir, const std::vector<Path>& rings) {
   const MoveId attr = cap_attr(dir, rings);
   for (const Path& ring : rings)
     for (const Point& x : ring) pd_.verts[x].attr = std::max(pd_.verts[x].attr, attr);
-  std::vector<const Path*> ring_ptrs;
-  for (const Path& ring : rings) ring_ptrs.push_back(&ring);
+  ring_ptrs_.clear();
+  for (const Path& ring : rings) ring_ptrs_.push_back(&ring);
   scratch_.tris.clear();
-  pd_.forced += triangulate(ring_ptrs, scratch_.tris, scratch_.triangulate).forced;
+  pd_.forced += triangulate(ring_ptrs_, scratch_.tris, scratch_.triangulate).forced;
   for (const Triangle2& t : scratch_.tris) {
     Tri tri{{t[0], t[1], t[2]}, {k_, k_, k_}};
     if (dir == 1) std::swap(tri.p[1], tri.p[2]);
