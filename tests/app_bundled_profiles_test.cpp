@@ -167,3 +167,40 @@ TEST(BundledProfiles, Live6Axis) {
   EXPECT_EQ(p.solid.chord_tol_mm, 0.001);            // geom default
   EXPECT_EQ(p.machine.g54_origin_mm[2], 0.0);         // nc default
 }
+
+namespace {
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)app::parse_profile(text, "m.toml");
+  } catch (const app::ProfileError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+const std::string kStock = "[stock]\nshape = \"box\"\nmin_mm = [0, 0, -10]\nmax_mm = [50, 40, 0]\n";  // lines 1-4
+
+}  // namespace
+
+// Each module's reader reports "file:line: table.key: what was expected", as parse_profile did
+// when it read every table itself.
+TEST(BundledProfiles, EveryModulesReaderNamesFileLineAndKey) {
+  EXPECT_EQ(error_of(kStock + "[machine]\ndiameter_programming = false\n"),  // nc
+            "m.toml:6: machine.diameter_programming: only for machine kind lathe or lathe-c");
+  EXPECT_EQ(error_of(kStock + "[machine]\ntool_change_s = -1\n"), "m.toml:6: machine.tool_change_s: expected a number in [0, 3600] s, got -1");
+  EXPECT_EQ(error_of(kStock + "[machine]\nkind = \"mill5\"\ntcp = 1\n"), "m.toml:7: machine.tcp: expected true or false");  // kin
+  EXPECT_EQ(error_of(kStock + "[machine]\nspeed = 1\n"), "m.toml:6: machine.speed: unknown key");  // after kin and nc
+  EXPECT_EQ(error_of(kStock + "[nc]\nsubroutine_path = \"subs\"\n"), "m.toml:6: nc.subroutine_path: expected an array of folder names");
+  EXPECT_EQ(error_of(kStock + "[nc]\ndialekt = \"x\"\n"), "m.toml:6: nc.dialekt: unknown key");
+  EXPECT_EQ(error_of(kStock + "[render]\nrate_hz = 500\n"), "m.toml:6: render.rate_hz: expected a number in [1, 240] Hz, got 500");  // gfx
+  EXPECT_EQ(error_of(kStock + "[threads]\n\ngeometry_cpu = -2\n"), "m.toml:7: threads.geometry_cpu: expected an integer in [-1, 1023]");  // sched
+  EXPECT_EQ(error_of(kStock + "[live]\n[live.serial]\nbaud = 10\n"), "m.toml:7: live.serial.baud: expected an integer in [1200, 4000000]");  // hal
+  EXPECT_EQ(error_of(kStock + "[[live.axis]]\naxis = \"X\"\nscale = 0\n"), "m.toml:7: live.axis.scale: must not be 0");
+  EXPECT_EQ(error_of(kStock + "[[tool]]\nnumber = 1\nkind = \"bull\"\ndiameter_mm = 6\n"),  // motion
+            "m.toml:5: tool.corner_radius_mm: missing (a number [mm] is required)");
+  EXPECT_EQ(error_of(kStock + "[lbr]\nstrictly_simple = 1\n"), "m.toml:6: lbr.strictly_simple: expected true or false");  // geom
+  EXPECT_EQ(error_of(kStock + "[lbr]\nthreads = 999\n"), "m.toml:6: lbr.threads: expected an integer in [0, 256]");  // app
+  EXPECT_EQ(error_of("[stock]\nshape = \"cylinder\"\ncenter_mm = [0, 0]\ndiameter_mm = 10\nz_min_mm = 0\nz_max_mm = 0\n"),
+            "m.toml:6: stock.z_max_mm: must be greater than z_min_mm");
+  EXPECT_EQ(error_of("tool = 3\n" + kStock), "m.toml:1: tool: expected an array of tables [[tool]]");
+}
