@@ -316,7 +316,7 @@ TEST(GcodeMisc, SpindleCoolantFeedModesAreAccepted) {
 
 TEST(GcodeMachines, RotaryAxesCarried) {
   GcodeOptions o;
-  o.machine = MachineKind::MillRotary;
+  o.machine = MachineKind::Mill5;
   const Toolpath tp = run("G0 A90 B10 C-5\nG91 G1 A10 F100\n", o);
   ASSERT_EQ(tp.segments.size(), 2u);
   EXPECT_DOUBLE_EQ(tp.segments[0].end[A], 90);

@@ -96,10 +96,10 @@ double machining_time_s(const Profile& profile, const nc::Toolpath& path) {
   nc::AxisVector pos = path.start;
   for (const nc::Segment& s : path.segments) {
     switch (s.kind) {
-      case nc::SegmentKind::Rapid: t += distance(pos, s.end) / profile.rapid_mm_per_min * 60.0; break;
+      case nc::SegmentKind::Rapid: t += distance(pos, s.end) / profile.machine.rapid_mm_per_min * 60.0; break;
       case nc::SegmentKind::Feed: t += distance(pos, s.end) / s.feed_mm_per_min * 60.0; break;
       case nc::SegmentKind::Dwell: t += s.dwell_s; break;
-      case nc::SegmentKind::ToolChange: t += profile.tool_change_s; break;
+      case nc::SegmentKind::ToolChange: t += profile.machine.tool_change_s; break;
     }
     pos = s.end;
   }
@@ -113,7 +113,7 @@ geom::SolidSpec batch_solid_spec(const Profile& profile, const motion::ToolTable
 }
 
 BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress) {
-  motion::ToolTable tools(tool_config(profile), profile.solid.chord_tol_mm, profile.source);
+  motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   tools.require_path(path);
   BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
@@ -126,7 +126,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
 
 BatchResult run_batch_channels(const Profile& profile, const std::vector<ChannelPath>& channels, bool sampled,
                                const Progress& progress) {
-  motion::ToolTable tools(tool_config(profile), profile.solid.chord_tol_mm, profile.source);
+  motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   for (const ChannelPath& c : channels) tools.require_path(c.path);
   BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();

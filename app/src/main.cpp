@@ -93,12 +93,12 @@ double parse_period_ms(const std::string& s) {
 
 int run_emulate_command(const EmulateOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
-  if (!o.period.empty()) profile.sample_period_ms = parse_period_ms(o.period);
+  if (!o.period.empty()) profile.machine.sample_period_ms = parse_period_ms(o.period);
   const nc::Toolpath path = app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   nc::Emulator em(path, app::emulator_limits(profile));
   const std::uint64_t n = app::write_samples_csv(o.out, em);
   std::printf("%llu samples every %.4g ms | machining %.3f s | %zu segments | wrote %s\n",
-              static_cast<unsigned long long>(n), profile.sample_period_ms, em.total_time_s(), path.segments.size(),
+              static_cast<unsigned long long>(n), profile.machine.sample_period_ms, em.total_time_s(), path.segments.size(),
               o.out.c_str());
   return 0;
 }
@@ -230,7 +230,7 @@ int run_batch_command(const BatchOptions& o) {
     emulated_time_s = nc::emulated_time_s(path, limits);
     if (o.sampled) {
       path = nc::sampled_toolpath(path, limits);
-      spdlog::info("sampled every {} ms: {} segments", profile.sample_period_ms, path.segments.size());
+      spdlog::info("sampled every {} ms: {} segments", profile.machine.sample_period_ms, path.segments.size());
     }
   }
 
@@ -299,7 +299,7 @@ void install_stop_handlers() {
 
 gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profile& profile) {
   gfx::RenderThreadConfig rc;
-  rc.rate_hz = o.rate_hz > 0 ? o.rate_hz : profile.render_rate_hz;
+  rc.rate_hz = o.rate_hz > 0 ? o.rate_hz : profile.render.rate_hz;
   rc.view = gfx::parse_view(o.view);
   rc.ortho = rc.view == gfx::StandardView::Top;
   rc.render.color = gfx::parse_color_mode(o.color);
@@ -614,7 +614,7 @@ int run_tune_command(const TuneOptions& o) {
   const nc::Toolpath sampled = nc::sampled_toolpath(path, app::emulator_limits(profile));
   const double machining = nc::emulated_time_s(path, app::emulator_limits(profile));
   double dmax = 1.0;
-  for (const auto& [n, t] : profile.tools) dmax = std::max(dmax, t.diameter_mm);
+  for (const auto& [n, t] : profile.tooling.tools) dmax = std::max(dmax, t.diameter_mm);
   const auto grids = app::tune_candidates(profile, dmax);
   std::printf("tune: %s, %zu samples, %zu grids, one kernel thread\n", o.program.c_str(), sampled.segments.size(),
               grids.size());
@@ -654,8 +654,8 @@ int run_profile_command(const ProfileOptions& o) {
     return 2;
   }
   const app::Profile p = app::load_profile(o.check_path);
-  std::printf("%s: ok (machine %s, %zu tools, level spacing %.4g mm)\n", o.check_path.c_str(), p.machine_kind.c_str(),
-              p.tools.size(), p.solid.level_spacing_mm);
+  std::printf("%s: ok (machine %s, %zu tools, level spacing %.4g mm)\n", o.check_path.c_str(), nc::to_string(p.kin.kind),
+              p.tooling.tools.size(), p.solid.level_spacing_mm);
   return 0;
 }
 

@@ -65,7 +65,7 @@ std::vector<ChannelPath> load_channel_paths(const Profile& profile, Interpreter 
     const std::filesystem::path prog =
         std::filesystem::path(c.program).is_absolute() ? std::filesystem::path(c.program) : dir / c.program;
     Profile per = profile;
-    per.g54_origin_mm = c.g54_origin_mm;
+    per.machine.g54_origin_mm = c.g54_origin_mm;
     channels.push_back({c.name, load_toolpath(prog.string(), per, interpreter), c.kin});
   }
   return channels;

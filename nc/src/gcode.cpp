@@ -266,7 +266,7 @@ class Interpreter {
   bool axis_allowed(int a) const {
     switch (opt_.machine) {
       case MachineKind::Mill3: return a <= Z;
-      case MachineKind::MillRotary: return a <= Z || opt_.rotary[static_cast<std::size_t>(a - A)];
+      case MachineKind::Mill5: return a <= Z || opt_.rotary[static_cast<std::size_t>(a - A)];
       case MachineKind::Lathe: return a == X || a == Z;
       case MachineKind::LatheC: return a == X || a == Y || a == Z || a == C;
     }
@@ -275,7 +275,7 @@ class Interpreter {
   const char* machine_name() const {
     switch (opt_.machine) {
       case MachineKind::Mill3: return "mill3 has X Y Z";
-      case MachineKind::MillRotary: return rotary_name();
+      case MachineKind::Mill5: return rotary_name();
       case MachineKind::Lathe: return "lathe has X Z";
       case MachineKind::LatheC: return "lathe-c has X Y Z C";
     }

@@ -19,20 +19,13 @@
 #include <string>
 #include <vector>
 
+#include "nc/machine_kind.hpp"
 #include "nc/toolpath.hpp"
 
 namespace lbr::nc {
 
-// Which axis words a program may use.
-enum class MachineKind : unsigned char {
-  Mill3,       // X Y Z
-  MillRotary,  // X Y Z and the rotary axes of GcodeOptions::rotary ([deg], carried into Segment::end[A..C])
-  Lathe,       // X Z; G7 diameter mode / G8 radius mode apply to X words
-  LatheC,      // X Y Z C (C spindle positioning [deg], live tools); G7 / G8 as Lathe
-};
-
 struct GcodeOptions {
-  MachineKind machine = MachineKind::Mill3;
+  MachineKind machine = MachineKind::Mill3;  // which axis words a program may use
   std::map<int, double> tool_lengths;    // tool number -> gauge line to tip [mm]; missing = 0
   std::map<int, double> tool_diameters;  // tool number -> diameter [mm]; used by rs274's cutter
                                          // compensation (the built-in interpreter rejects G41/G42)
@@ -49,7 +42,7 @@ struct GcodeOptions {
   // Directories searched for NAME.ngc when a program calls o<name> that it does not define,
   // after the program's own directory (profile [nc] subroutine_path; LinuxCNC's SUBROUTINE_PATH).
   std::vector<std::string> subroutine_path;
-  // MillRotary: which of A, B, C the machine has (a word for a missing one is an error).
+  // Mill5: which of A, B, C the machine has (a word for a missing one is an error).
   std::array<bool, 3> rotary{true, true, true};
   // At most this many blocks are executed (loops included); more is an error, not a hang. 0: no limit.
   long max_blocks = 20000000;
