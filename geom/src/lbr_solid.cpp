@@ -28,7 +28,6 @@ bool in_range(double mm) { return std::isfinite(mm) && std::abs(mm) <= kSafeRang
 
 }  // namespace
 
-
 LbrSolid::LbrSolid(const SolidSpec& spec) : spec_(spec), ws_(std::make_unique<detail::SubtractWorkspace>()) {
   require(std::isfinite(spec.level_spacing_mm) && spec.level_spacing_mm >= 0.001 && spec.level_spacing_mm <= 1000.0,
           "level spacing must be in [0.001, 1000] mm");

@@ -24,7 +24,6 @@ void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
   co.Execute(off.paths, (sh.offset_keys[o].r + 0.25 * tol) * kUnitsPerMm);
 }
 
-
 void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                                  SubtractStats& stats) const {
   const double zc = s_.level_z_mm(level);

@@ -131,7 +131,7 @@ class LbrSolid {
   // height. Changed cells become dirty; cut contours get `id`. Allocates.
   SubtractStats subtract_solid(const LbrSolid& other, MoveId id = 0);
 
-  // --- geometry of the grid ---
+  // --- geometry of the grid; contents (real-time safe: no allocation, no locks) ---
   [[nodiscard]] const SolidSpec& spec() const noexcept { return spec_; }
   [[nodiscard]] int levels() const noexcept { return levels_; }
   [[nodiscard]] int regions_x() const noexcept { return spec_.regions_x; }
@@ -148,7 +148,6 @@ class LbrSolid {
   [[nodiscard]] Rect region_rect(int region) const noexcept;
   [[nodiscard]] Rect stock_rect() const noexcept { return xy_; }
 
-  // --- contents ---
   [[nodiscard]] const Cell& cell(int region, int level) const noexcept {
     return cells_[static_cast<std::size_t>(region) * levels_ + level];
   }
@@ -176,7 +175,7 @@ class LbrSolid {
   [[nodiscard]] std::string check_invariants() const;
 
   // Replaces the content of one cell (used by deserialisation, the render-side mirror and
-  // tests). Marks it dirty.
+  // tests). Marks it dirty. Allocates.
   void set_cell(int region, int level, std::vector<Polygon> polys, MoveId last_cut = 0);
 
  private:
