@@ -7,7 +7,8 @@
 //   batch_plan.cpp      prepare(): merging, sweeps, chains, the levels and offsets a batch reaches
 //   level_sections.cpp  a level's sections (joined runs, trimmed tilted sections, chains,
 //                       lathe regions) and the chain offsets and their region pieces
-//   subtract_phases.cpp run(): the phases A-D over the threads, and one cell's clip
+//   subtract_phases.cpp run(): the phases A-D over the threads
+//   cell_clip.cpp       one cell's clip by its level's sections (phase C)
 #pragma once
 
 #include <cstdint>
@@ -69,6 +70,8 @@ class SubtractEngine {
   void clip_phase(SubtractShared& sh, SubtractWorkspace& ws, const SubtractAhead* ahead, SubtractStats& stats);  // C
   void copy_runs(const SubtractShared& sh, const SubtractWorkspace& ws, int index, int count,
                  SubtractStats& stats);                                                                    // D
+
+  // --- cell_clip.cpp ---
   void add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const;
   bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                  SubtractStats& stats);
