@@ -1,6 +1,6 @@
 #include "app/batch.hpp"
 
-#include "app/level_pool.hpp"
+#include "geom/parallel_subtractor.hpp"
 #include "motion/path_sweeps.hpp"
 #include "motion/tool_table.hpp"
 
@@ -21,7 +21,7 @@ double distance(const nc::AxisVector& a, const nc::AxisVector& b) {
 
 // Subtracts the moves in order, profile.batch_moves at a time.
 void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& moves, BatchResult& r, const Progress& progress) {
-  LevelPool pool(profile.threads);
+  geom::ParallelSubtractor pool(profile.threads);
   r.threads = pool.threads();
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0;
@@ -46,7 +46,7 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   // while the current one is clipped).
   const std::size_t per = static_cast<std::size_t>(std::max(1, profile.batch_moves));
   std::size_t begin = 0;
-  const LevelPool::BatchSource source = [&](std::vector<geom::SweepRef>& out) {
+  const geom::ParallelSubtractor::BatchSource source = [&](std::vector<geom::SweepRef>& out) {
     if (begin >= moves.size()) return false;
     const std::size_t end = std::min(begin + per, moves.size());
     fill(begin, end, out);
@@ -54,7 +54,7 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
     return true;
   };
   std::size_t done_moves = 0;
-  const LevelPool::BatchDone done = [&](const geom::SubtractStats&) {
+  const geom::ParallelSubtractor::BatchDone done = [&](const geom::SubtractStats&) {
     done_moves = std::min(done_moves + per, moves.size());
     if (!progress) return;
     const auto now = std::chrono::steady_clock::now();

@@ -106,7 +106,6 @@ void PathStreamer::loop() {
   std::vector<geom::SweepRef> batch;
   batch.reserve(4096);
   batch_ms_.reserve(1 << 16);
-  geom::SubtractWorkspace ws;
   const auto start = clock::now();
   const auto tick = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(opt_.tick_s));
   auto next = start;
@@ -125,7 +124,7 @@ void PathStreamer::loop() {
     }
     if (!batch.empty()) {
       const auto t0 = clock::now();
-      solid_.subtract(batch, ws);
+      solid_.subtract(batch);
       batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
       batches_.fetch_add(1, std::memory_order_relaxed);
       tool_count = tools_at(i, tools);
