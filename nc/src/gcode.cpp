@@ -16,6 +16,7 @@
 #include <sstream>
 #include <vector>
 
+#include "fanuc.hpp"
 #include "ngc_control.hpp"
 #include "ngc_expr.hpp"
 #include "path_builder.hpp"
@@ -89,6 +90,13 @@ class Interpreter {
         offsets_(o.work_offsets), g28_(o.g28_home), g30_(o.g30_home) {
     selected_tool_ = o.start_tool;
     params_.numbered_hook = [this](int n, double& v) { return system_numbered(n, v); };
+    if (fanuc_) {  // Fanuc variables; its system variables read the same state (fanuc.hpp)
+      params_.use_fanuc_variables();
+      params_.numbered_hook = [this](int n, double& v) {
+        const int m = detail::fanuc_system_variable(n);
+        return m != 0 && system_numbered(m, v);
+      };
+    }
     params_.named_hook = [this](const std::string& n, double& v) { return system_named(n, v); };
   }
 
@@ -217,6 +225,7 @@ class Interpreter {
       const std::size_t num_start = i;
       double v = word_value(s, i, L);
       const std::string written = s.substr(num_start, i - num_start);
+      if (detail::is_vacant(v)) continue;  // fanuc: a word whose value is <vacant> is not given
       if (detail::ExprReader::number_starts(written, written[0] == '+' || written[0] == '-' ? 1 : 0) &&
           written.find_first_of("[#") == std::string::npos && !is_function_at(written, 0))
         v = std::strtod(written.c_str(), nullptr);
@@ -450,8 +459,8 @@ class Interpreter {
     if (mcool != nullptr) coolant_ = static_cast<int>(mcool->value);
     // 6. dwell
     if (dwell != 0) {
-      if (!has(b, 'P')) fail("'G4' needs P (dwell time [s])");
-      const double p = raw(b, 'P');
+      if (!has(b, 'P') && !fanuc_) fail("'G4' needs P (dwell time [s])");
+      const double p = fanuc_ ? fanuc_dwell_s(b) : raw(b, 'P');
       if (p < 0) fail("'" + text(b, 'P') + "': dwell time must be >= 0");
       b_.dwell(line_, p);
     }
@@ -565,6 +574,16 @@ class Interpreter {
   }
 
   static bool is_cycle(int c) { return c == 810 || c == 820 || c == 830 || c == 730; }
+
+  // Fanuc G4: P [ms] or X [s]; the X word is the dwell's, not a move.
+  double fanuc_dwell_s(Block& b) {
+    if (has(b, 'P') == has(b, 'X')) fail("'G4' needs P (dwell time [ms]) or X (dwell time [s])");
+    if (has(b, 'P')) return raw(b, 'P') * 0.001;
+    const double s = raw(b, 'X');
+    if (s < 0) fail("'" + text(b, 'X') + "': dwell time must be >= 0");
+    b.has[idx('X')] = false;
+    return s;
+  }
 
   // The program frame: the selected work offset plus the G92 offset while it is applied.
   void select_wcs(int k) {
@@ -800,7 +819,7 @@ class Interpreter {
       if (motion_ != 830 && motion_ != 730) fail("unused word '" + text(b, 'Q') + "' (" + g + " takes no Q)");
     }
     if (has(b, 'P')) {
-      cs.p = raw(b, 'P');
+      cs.p = raw(b, 'P') * (fanuc_ ? 0.001 : 1.0);  // fanuc: P [ms]
       cs.has_p = true;
       if (motion_ != 820) fail("unused word '" + text(b, 'P') + "' (" + g + " takes no P)");
     }
@@ -810,6 +829,7 @@ class Interpreter {
     const double f = feed_for_move(g, has(b, 'F'));
     int repeats = 1;
     if (has(b, 'L')) repeats = integer(b, 'L', 0, static_cast<int>(kMaxRepeats));
+    if (fanuc_ && has(b, 'K')) repeats = integer(b, 'K', 0, static_cast<int>(kMaxRepeats));  // fanuc: K repeats
 
     AxisVector p = b_.position();
     const double r = absolute_ ? cs.r : p[Z] + cs.r;
@@ -884,6 +904,7 @@ class Interpreter {
 
   std::string name_;
   const GcodeOptions& opt_;
+  bool fanuc_ = opt_.dialect == Dialect::Fanuc;
   PathBuilder b_;
   detail::Params params_;
   detail::ExprReader expr_;
