@@ -484,6 +484,9 @@ Profile parse_profile(const std::string& text, const std::string& name) {
   if (const toml::table* nt = top.table("nc")) {  // G-code front ends
     Section s(*nt, "nc", name);
     p.start_tool = static_cast<int>(s.integer("start_tool", 0, 0, 99999));
+    const std::string dialect = s.string("dialect", "rs274ngc");
+    if (!nc::parse_dialect(dialect, p.dialect))
+      s.fail(s.raw().get("dialect"), "dialect", "expected rs274ngc or fanuc; got '" + dialect + "'");
     if (const toml::node* n = s.get("subroutine_path")) {
       const toml::array* a = n->as_array();
       if (a == nullptr) s.fail(n, "subroutine_path", "expected an array of folder names");
@@ -555,6 +558,7 @@ nc::GcodeOptions gcode_options(const Profile& p) {
     o.rotary = {ac, !ac, true};
   }
   o.subroutine_path = p.subroutine_path;
+  o.dialect = p.dialect;
   o.start_tool = p.start_tool;
   o.chord_tol_mm = p.solid.chord_tol_mm;
   for (int a = 0; a < 3; ++a) o.work_offsets[0][a] = p.g54_origin_mm[static_cast<std::size_t>(a)];

@@ -941,6 +941,13 @@ class Interpreter {
 
 }  // namespace
 
+bool parse_dialect(const std::string& name, Dialect& out) {
+  if (name == "rs274ngc") out = Dialect::Rs274ngc;
+  else if (name == "fanuc") out = Dialect::Fanuc;
+  else return false;
+  return true;
+}
+
 Toolpath interpret_gcode(const std::string& text, const std::string& name, const GcodeOptions& options) {
   if (!(options.chord_tol_mm > 0.0)) throw ParseError(name, 0, "chord tolerance must be > 0 mm");
   Interpreter in(name, options);

@@ -310,7 +310,11 @@ bool ControlFlow::oword(const OWord& o) {
   const NgcFile& f = *a.file;
   const std::size_t i = a.pc;
   switch (o.kind) {
-    case OKind::None: fail("O-word 'O" + o.label + "' without a keyword (sub, call, if, while, do, repeat, ...)");
+    case OKind::None:
+      fail("O-word 'O" + o.label + "' without a keyword (sub, call, if, while, do, repeat, ...)" +
+           (o.label.find_first_not_of("0123456789") == std::string::npos
+                ? "; a Fanuc program number needs [nc] dialect = \"fanuc\" or --dialect fanuc"
+                : ""));
     case OKind::Sub: a.pc = f.end[i] + 1; break;
     case OKind::EndSub:
     case OKind::Return:

@@ -60,6 +60,7 @@ struct Profile {
   // [nc]: G-code front ends (docs/profiles.md, docs/nc-frontend.md).
   std::vector<std::string> subroutine_path;    // searched for NAME.ngc after the program's folder
   int start_tool = 0;                          // tool in the spindle at program start (0: none)
+  nc::Dialect dialect = nc::Dialect::Rs274ngc;  // program syntax of the built-in interpreter
   // Mount of tool n on this machine (Spindle on mills).
   [[nodiscard]] kin::Mount mount_of(int tool) const;
 };

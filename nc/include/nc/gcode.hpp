@@ -37,6 +37,9 @@ enum class Dialect : unsigned char {
   Fanuc,     // ISO/Fanuc: O numbers, M98/M99, G65/G66 macros, IF/GOTO/WHILE (docs/nc-frontend.md#fanuc-dialect)
 };
 
+// "rs274ngc" / "fanuc" (profile [nc] dialect, --dialect): false for any other name.
+[[nodiscard]] bool parse_dialect(const std::string& name, Dialect& out);
+
 struct GcodeOptions {
   MachineKind machine = MachineKind::Mill3;
   Dialect dialect = Dialect::Rs274ngc;
