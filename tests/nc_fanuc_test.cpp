@@ -264,6 +264,11 @@ TEST(FanucDialect, ErrorsNameFileAndLine) {
   EXPECT_EQ(error_of("M98 P9\n", ngc), "t.nc:1: unsupported word 'M98' (not supported by the built-in interpreter; use --interpreter rs274)");
 }
 
+TEST(FanucDialect, RefusalsOfTheBuiltinSayNothingOfRs274) {
+  EXPECT_EQ(error_of("G0 X1.\nG84 Z-5. R2. F100.\n"), "t.nc:2: unsupported word 'G84' (this cycle)");
+  EXPECT_EQ(error_of("M98 P9\nM30\nO9\nG0 X1.\nO10\nM99\n"), "t.nc:5: program O9 runs into program O10 (no M99)");
+}
+
 TEST(FanucDialect, M99InTheMainProgramEndsIt) {
   const auto e = ends(run("G0 X1.\nM99\nG0 X2.\n"));
   ASSERT_EQ(e.size(), 1u);

@@ -106,7 +106,11 @@ class Interpreter {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& msg) const { flow_.fail(msg); }
+  // The rs274 hint does not apply to the fanuc dialect, which rs274 cannot read.
+  [[noreturn]] void fail(const std::string& msg) const {
+    const std::size_t hint = fanuc_ ? msg.find(kUseRs274) : std::string::npos;
+    flow_.fail(hint == std::string::npos ? msg : msg.substr(0, hint) + msg.substr(hint + std::string(kUseRs274).size()));
+  }
 
   // One line that is not an O-word line: parameter settings take effect after the whole line
   // has been read (RS274/NGC), then the block executes. Returns true at the program's end.

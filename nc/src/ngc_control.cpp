@@ -259,7 +259,7 @@ bool ControlFlow::step() {
   Activation& a = stack_.back();
   const NgcFile& f = *a.file;
   if (a.pc >= f.lines.size()) {
-    if (stack_.size() > 1) fail("end of file inside subroutine o" + a.label);
+    if (stack_.size() > 1) fail(f.fanuc ? "program O" + a.label + " ends without M99" : "end of file inside subroutine o" + a.label);
     return false;
   }
   if (opt_.max_blocks > 0 && ++executed_ > opt_.max_blocks)
@@ -315,7 +315,10 @@ bool ControlFlow::oword(const OWord& o) {
            (o.label.find_first_not_of("0123456789") == std::string::npos
                 ? "; a Fanuc program number needs [nc] dialect = \"fanuc\" or --dialect fanuc"
                 : ""));
-    case OKind::Sub: a.pc = f.end[i] + 1; break;
+    case OKind::Sub:
+      if (f.fanuc && stack_.size() > 1) fail("program O" + a.label + " runs into program O" + o.label + " (no M99)");
+      a.pc = f.end[i] + 1;
+      break;
     case OKind::EndSub:
     case OKind::Return:
       if (f.fanuc) return fanuc_return(o);
