@@ -267,6 +267,7 @@ TEST(FanucDialect, ErrorsNameFileAndLine) {
 TEST(FanucDialect, RefusalsOfTheBuiltinSayNothingOfRs274) {
   EXPECT_EQ(error_of("G0 X1.\nG84 Z-5. R2. F100.\n"), "t.nc:2: unsupported word 'G84' (this cycle)");
   EXPECT_EQ(error_of("M98 P9\nM30\nO9\nG0 X1.\nO10\nM99\n"), "t.nc:5: program O9 runs into program O10 (no M99)");
+  EXPECT_EQ(error_of("M98 P9\nM30\nO9\nG0 X1."), "t.nc:4: program O9 ends without M99");
 }
 
 TEST(FanucDialect, M99InTheMainProgramEndsIt) {

@@ -259,6 +259,7 @@ bool ControlFlow::step() {
   Activation& a = stack_.back();
   const NgcFile& f = *a.file;
   if (a.pc >= f.lines.size()) {
+    if (stack_.size() > 1) a.pc = f.lines.size() - 1;  // reported at the file's last line
     if (stack_.size() > 1) fail(f.fanuc ? "program O" + a.label + " ends without M99" : "end of file inside subroutine o" + a.label);
     return false;
   }
