@@ -226,6 +226,12 @@ TEST(FanucDialect, DwellIsInMillisecondsAndCyclesRepeatWithK) {
   EXPECT_NEAR(last_x, 30.0, 1e-12);
 }
 
+TEST(FanucDialect, SafetyBlockCancelsAreAccepted) {
+  const auto e = ends(run("G15 G17 G40 G49 G50 G50.1 G69 G80 G90\nG0 X1.\n"));
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_EQ(error_of("G68 X0 Y0 R30.\n"), "t.nc:1: unsupported word 'G68' (not supported by the built-in interpreter)");
+}
+
 TEST(FanucDialect, SubprogramFileOnTheSearchPath) {
   const auto dir = std::filesystem::temp_directory_path() / "lbr-fanuc-subpath";
   std::filesystem::create_directories(dir / "lib");

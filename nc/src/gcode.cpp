@@ -378,6 +378,7 @@ class Interpreter {
     std::array<const Word*, kGroups> gw{};
     std::vector<const Word*> nonmodal;
     for (const Word& w : b.g) {
+      if (fanuc_ && fanuc_cancel(w)) continue;
       const int gr = group_of(w);
       if (gr < 0) fail(unsupported_g(w));
       if (gr == kNonModal) {
@@ -578,6 +579,14 @@ class Interpreter {
   }
 
   static bool is_cycle(int c) { return c == 810 || c == 820 || c == 830 || c == 730; }
+
+  // Fanuc safety blocks cancel modes the interpreter never enters: G15 (polar coordinates),
+  // G50.1 (mirror image), G69 (rotation) and, on mills, G50 (scaling). Nothing to do.
+  bool fanuc_cancel(const Word& w) const {
+    const int c = code10(w);
+    const bool mill = opt_.machine == MachineKind::Mill3 || opt_.machine == MachineKind::MillRotary;
+    return c == 150 || c == 501 || c == 690 || (c == 500 && mill);
+  }
 
   // Fanuc G4: P [ms] or X [s]; the X word is the dwell's, not a move.
   double fanuc_dwell_s(Block& b) {
