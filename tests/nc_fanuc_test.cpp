@@ -3,10 +3,15 @@
 // errors it refuses with. Positions are hand-computed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -279,6 +284,57 @@ TEST(FanucDialect, RefusalsOfTheBuiltinSayNothingOfRs274) {
 TEST(FanucDialect, M99InTheMainProgramEndsIt) {
   const auto e = ends(run("G0 X1.\nM99\nG0 X2.\n"));
   ASSERT_EQ(e.size(), 1u);
+}
+
+// Seeded random mutations of Fanuc programs: every run ends in a Toolpath or a ParseError naming
+// a line of the input, never in another exception, a crash or a hang. LBR_FUZZ_SEED=<n>
+// reproduces a run; the budget is a few seconds.
+TEST(FanucDialect, SeededMutatorNeverCrashesOrHangs) {
+  const std::vector<std::string> corpus = {
+      read_text_file(lbr::test::program_file("fanuc-flange.nc")),
+      "#1=0\nWHILE[#1LT3]DO1\n#2=0\nWHILE[#2LT2]DO2\nG0X#1Y#2\n#2=#2+1\nEND2\n#1=#1+1\nEND1\nM30\n",
+      "G66P9Z-2.\nG0X10.\nG67\nM98P9L2\nIF[#0EQ#0]GOTO5\nN5M99\nO9\nG1Z#26F100.\n#100=ATAN[1,2]+POW[2,3]\nM99P5\n",
+  };
+  const char* env = std::getenv("LBR_FUZZ_SEED");
+  const unsigned seed = env != nullptr ? static_cast<unsigned>(std::strtoul(env, nullptr, 10)) : 20261124u;
+  std::mt19937 rng(seed);
+  const std::string alphabet = "GMXYZPLKOND#[]=0123456789.-+ ()%;/\nIFWHILEDOENDGOTOTHEN";
+  GcodeOptions o = fanuc();
+  o.chord_tol_mm = 0.01;
+  o.max_blocks = 100000;  // mutated loops may never end
+  const auto t0 = std::chrono::steady_clock::now();
+  int runs = 0, parsed = 0;
+  for (; runs < 20000; ++runs) {
+    if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(3)) break;
+    std::string s = corpus[rng() % corpus.size()];
+    const int edits = 1 + static_cast<int>(rng() % 6);
+    for (int e = 0; e < edits && !s.empty(); ++e) {
+      const std::size_t pos = rng() % s.size();
+      switch (rng() % 4) {
+        case 0: s.erase(pos, 1 + rng() % 3); break;
+        case 1: s.insert(pos, 1, alphabet[rng() % alphabet.size()]); break;
+        case 2: s[pos] = alphabet[rng() % alphabet.size()]; break;
+        default: s.insert(pos, s.substr(rng() % s.size(), rng() % 12)); break;
+      }
+    }
+    const long lines = 1 + std::count(s.begin(), s.end(), '\n');
+    try {
+      const Toolpath tp = interpret_gcode(s, "fuzz.nc", o);
+      ++parsed;
+      for (const Segment& seg : tp.segments) {
+        for (double v : seg.end) ASSERT_TRUE(std::isfinite(v)) << "seed " << seed << " run " << runs << ":\n" << s;
+        ASSERT_GE(seg.line, 1);
+        ASSERT_LE(seg.line, lines);
+      }
+    } catch (const ParseError& e) {
+      ASSERT_GE(e.line(), 1) << e.what() << "\n" << s;
+      ASSERT_LE(e.line(), lines) << e.what() << "\n" << s;
+    }
+  }
+  std::printf("fuzz: seed %u, %d runs, %d interpreted, %d rejected\n", seed, runs, parsed, runs - parsed);
+  EXPECT_GT(runs, 200);
+  EXPECT_GT(parsed, 0);
+  EXPECT_LT(parsed, runs);
 }
 
 }  // namespace
