@@ -6,13 +6,17 @@
 //   end:  if/elseif/else -> the endif; while/do/repeat -> the line closing the loop;
 //         sub -> its endsub.
 // so that running a program is a walk over an index with a stack of activations (one per
-// subroutine call), as LinuxCNC's interpreter does it with its offset table.
+// subroutine call), as LinuxCNC's interpreter does it with its offset table. The fanuc
+// dialect's scanner (fanuc.cpp) fills the same indices for WHILE/DO/END; its other
+// statements (M98/M99 calls with passes, GOTO, #i = ..., G66) are run at the end of this file.
 #include "ngc_control.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include "fanuc.hpp"
 #include <filesystem>
 #include <sstream>
+
+#include "fanuc.hpp"
 
 namespace lbr::nc::detail {
 
@@ -541,7 +545,7 @@ void ControlFlow::assign(const OWord& o) {
     if (p != o.words.size()) fail("unexpected '" + o.words.substr(p) + "' after the assignment");
     if (pa.number == 3000) {
       const NormalisedLine& l = stack_.back().file->lines[stack_.back().pc];
-      const double n = is_vacant(pa.value) ? 0.0 : std::floor(pa.value);
+      const double n = is_vacant(pa.value) ? 0.0 : std::clamp(std::floor(pa.value), -1e6, 1e6);
       fail("macro alarm " + std::to_string(3000 + static_cast<long>(n)) + " (#3000): " +
            (l.comments.empty() ? std::string("no message") : l.comments.front()));
     }
