@@ -145,3 +145,12 @@ TEST(Profile, NcSectionReachesTheInterpreterOptions) {
   EXPECT_EQ(o.subroutine_path[1], "/abs/lib");
   EXPECT_NE(error_of(std::string(kStock) + "\n[nc]\nstart_tol = 1\n").find("nc.start_tol: unknown key"), std::string::npos);
 }
+
+// [nc] dialect selects the built-in interpreter's program syntax (docs/nc-frontend.md#fanuc-dialect).
+TEST(Profile, NcDialectReachesTheInterpreterOptions) {
+  EXPECT_EQ(app::gcode_options(app::parse_profile(std::string(kStock), "m.toml")).dialect, nc::Dialect::Rs274ngc);
+  const app::Profile p = app::parse_profile(std::string(kStock) + "\n[nc]\ndialect = \"fanuc\"\n", "m.toml");
+  EXPECT_EQ(app::gcode_options(p).dialect, nc::Dialect::Fanuc);
+  const std::string e = error_of(std::string(kStock) + "\n[nc]\ndialect = \"iso\"\n");
+  EXPECT_NE(e.find("nc.dialect: expected rs274ngc or fanuc; got 'iso'"), std::string::npos) << e;
+}

@@ -37,6 +37,7 @@ using namespace lbr;
 
 struct BatchOptions {
   std::string program, profile, stock, regions, out = "lbrsim-out", interpreter = "builtin";
+  std::string dialect;  // --dialect: overrides the profile's [nc] dialect
   std::string stl, ply;  // mesh exports (empty: none)
   std::vector<std::string> tools;
   double level_spacing = 0.0;
@@ -61,7 +62,18 @@ struct ViewCliOptions {
 
 struct EmulateOptions {
   std::string program, profile, period, out = "samples.csv", interpreter = "builtin";
+  std::string dialect;
 };
+
+// --dialect NAME (rs274ngc, fanuc): the built-in interpreter's program syntax for this run.
+void add_dialect_option(CLI::App* c, std::string& dialect) {
+  c->add_option("--dialect", dialect, "G-code dialect of the built-in interpreter: rs274ngc or fanuc "
+                "(default: the profile's [nc] dialect)")
+      ->check(CLI::IsMember({"rs274ngc", "fanuc"}));
+}
+void apply_dialect(app::Profile& p, const std::string& dialect) {
+  if (!dialect.empty()) (void)nc::parse_dialect(dialect, p.nc.dialect);
+}
 
 // DIR/NAME as the user would type it ("out/" + metrics.json -> out/metrics.json, not out//).
 std::string out_file(const std::string& dir, const std::string& name) {
@@ -94,6 +106,7 @@ double parse_period_ms(const std::string& s) {
 int run_emulate_command(const EmulateOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
   if (!o.period.empty()) profile.machine.sample_period_ms = parse_period_ms(o.period);
+  apply_dialect(profile, o.dialect);
   const nc::Toolpath path = app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   nc::Emulator em(path, app::emulator_limits(profile));
   const std::uint64_t n = app::write_samples_csv(o.out, em);
@@ -169,6 +182,7 @@ app::Profile batch_profile(const BatchOptions& o) {
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
   if (o.threads >= 0) profile.threads = o.threads;
+  apply_dialect(profile, o.dialect);
   return profile;
 }
 
@@ -493,6 +507,7 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
                     "G-code front end: builtin, or rs274 (LinuxCNC's interpreter, package linuxcnc-uspace)")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  add_dialect_option(batch, b.dialect);
   batch->add_flag("--sampled", b.sampled,
                   "Run the kernel on the machine emulator's sampled stream (as live mode sees it) instead of the "
                   "interpreted segments");
@@ -526,6 +541,7 @@ CLI::App* add_view_command(CLI::App& cli, BatchOptions& vb, ViewCliOptions& vv) 
   view->add_option("--interpreter", vb.interpreter, "G-code front end: builtin or rs274")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  add_dialect_option(view, vb.dialect);
   view->add_option("--profile", vb.profile, "Machine profile (TOML)");
   view->add_option("--stock", vb.stock, "Override the stock (as for batch)");
   view->add_option("--tool", vb.tools, "Add or override a tool (as for batch)")->take_all();
@@ -590,6 +606,7 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateOptions& em) {
   emu->add_option("--interpreter", em.interpreter, "G-code front end: builtin or rs274")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  add_dialect_option(emu, em.dialect);
   return emu;
 }
 

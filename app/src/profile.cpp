@@ -172,6 +172,7 @@ nc::GcodeOptions gcode_options(const Profile& p) {
   }
   // [nc] keys (nc::FrontEndConfig) reach the front ends here.
   o.subroutine_path = p.nc.subroutine_path;
+  o.dialect = p.nc.dialect;
   o.start_tool = p.nc.start_tool;
   o.chord_tol_mm = p.solid.chord_tol_mm;
   for (int a = 0; a < 3; ++a) o.work_offsets[0][a] = p.machine.g54_origin_mm[static_cast<std::size_t>(a)];

@@ -18,6 +18,9 @@ void read_machine(cfg::Table& s, MachineKind kind, MachineConfig& m) {
 
 void read_nc(cfg::Table& s, FrontEndConfig& f) {
   f.start_tool = static_cast<int>(s.integer("start_tool", 0, 0, 99999));
+  const std::string dialect = s.string("dialect", "rs274ngc");
+  if (!parse_dialect(dialect, f.dialect))
+    s.fail(s.raw().get("dialect"), "dialect", "expected rs274ngc or fanuc; got '" + dialect + "'");
   if (const toml::node* n = s.get("subroutine_path")) {
     const toml::array* a = n->as_array();
     if (a == nullptr) s.fail(n, "subroutine_path", "expected an array of folder names");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "nc/emulator.hpp"
+#include "nc/gcode.hpp"  // Dialect
 
 namespace lbr::nc {
 
@@ -28,6 +29,7 @@ struct MachineConfig {
 struct FrontEndConfig {
   std::vector<std::string> subroutine_path;  // searched for NAME.ngc after the program's folder
   int start_tool = 0;                        // tool in the spindle at program start (0: none)
+  Dialect dialect = Dialect::Rs274ngc;       // program syntax of the built-in interpreter
 };
 
 // The emulator's limits from [machine] (X Y Z velocities of 0 take the rapid rate; the rotary

@@ -24,8 +24,18 @@
 
 namespace lbr::nc {
 
+// The program syntax the built-in interpreter reads (profile [nc] dialect).
+enum class Dialect : unsigned char {
+  Rs274ngc,  // LinuxCNC's RS274/NGC: O-word subroutines and control flow, #<named> parameters
+  Fanuc,     // ISO/Fanuc: O numbers, M98/M99, G65/G66 macros, IF/GOTO/WHILE (docs/nc-frontend.md#fanuc-dialect)
+};
+
+// "rs274ngc" / "fanuc" (profile [nc] dialect, --dialect): false for any other name.
+[[nodiscard]] bool parse_dialect(const std::string& name, Dialect& out);
+
 struct GcodeOptions {
-  MachineKind machine = MachineKind::Mill3;  // which axis words a program may use
+  MachineKind machine = MachineKind::Mill3;
+  Dialect dialect = Dialect::Rs274ngc;
   std::map<int, double> tool_lengths;    // tool number -> gauge line to tip [mm]; missing = 0
   std::map<int, double> tool_diameters;  // tool number -> diameter [mm]; used by rs274's cutter
                                          // compensation (the built-in interpreter rejects G41/G42)
@@ -41,6 +51,8 @@ struct GcodeOptions {
   bool diameter_mode = false;  // lathe kinds: G7 (X words are diameters) at program start
   // Directories searched for NAME.ngc when a program calls o<name> that it does not define,
   // after the program's own directory (profile [nc] subroutine_path; LinuxCNC's SUBROUTINE_PATH).
+  // The fanuc dialect looks there for O1234 / O1234.nc when M98 P1234 or G65 P1234 calls a
+  // program that the file does not hold.
   std::vector<std::string> subroutine_path;
   // Mill5: which of A, B, C the machine has (a word for a missing one is an error).
   std::array<bool, 3> rotary{true, true, true};
