@@ -50,6 +50,10 @@ class PathBuilder {
   // < 0 clockwise, |rotation| - 1 extra full turns. The radius may change linearly (spiral).
   void arc(int line, Plane p, const AxisVector& end, double cu, double cv, int rotation, double feed,
            bool inverse_time);
+  // Path control stamped on the segments that follow (G61 / G61.1 / G64 P Q).
+  void set_path_control(PathControl c, double blend_tol_mm, double naive_tol_mm) {
+    control_ = c, blend_tol_mm_ = blend_tol_mm, naive_tol_mm_ = naive_tol_mm;
+  }
   void dwell(int line, double seconds);
   void tool_change(int line, int tool);
 
@@ -67,6 +71,8 @@ class PathBuilder {
   AxisVector pos_{};
   int tool_ = 0;
   double length_ = 0.0;
+  PathControl control_ = PathControl::Blend;  // LinuxCNC starts in G64 without tolerance
+  double blend_tol_mm_ = 0.0, naive_tol_mm_ = 0.0;
 };
 
 }  // namespace lbr::nc::detail
