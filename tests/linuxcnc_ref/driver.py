@@ -1,0 +1,64 @@
+#!/usr/bin/python3
+# LinuxCNC "display" for the headless reference run: switches the simulated machine on, homes
+# it, runs the program LREF_PROG and records the commanded joint positions of every servo
+# period (halsampler, "SAMPLE X Y Z" per line) into LREF_OUT, then exits (LinuxCNC shuts down).
+import os
+import subprocess
+import time
+
+import linuxcnc
+
+prog, out = os.environ["LREF_PROG"], os.environ["LREF_OUT"]
+limit_s = float(os.environ.get("LREF_LIMIT_S", "120"))
+s, c = linuxcnc.stat(), linuxcnc.command()
+
+
+def wait(cond, limit_s):
+    t0 = time.time()
+    while time.time() - t0 < limit_s:
+        s.poll()
+        if cond():
+            return True
+        time.sleep(0.005)
+    return False
+
+
+def fail(what):
+    # LinuxCNC sends a display's output to a log it deletes: the verdict goes to OUT.status.
+    with open(out + ".status", "w") as f:
+        f.write("driver.py: " + what + "\n")
+    sys.exit(1)
+
+
+for attempt in range(5):  # task may still be starting: ask again
+    wait(lambda: False, 1.0)
+    c.state(linuxcnc.STATE_ESTOP_RESET)
+    c.wait_complete(5)
+    c.state(linuxcnc.STATE_ON)
+    c.wait_complete(5)
+    if wait(lambda: s.task_state == linuxcnc.STATE_ON, 5):
+        break
+else:
+    fail("machine did not switch on (task_state %d, estop %d)" % (s.task_state, s.estop))
+c.home(-1)
+if not wait(lambda: all(s.homed[i] for i in range(3)), 60):
+    fail("machine did not home")
+c.mode(linuxcnc.MODE_AUTO)
+wait(lambda: s.task_mode == linuxcnc.MODE_AUTO, 10)
+c.program_open(prog)
+with open(out, "w") as f:
+    rec = subprocess.Popen(["halsampler", "-t"], stdout=f)
+    time.sleep(0.3)
+    c.auto(linuxcnc.AUTO_RUN, 0)
+    started = wait(lambda: s.interp_state != linuxcnc.INTERP_IDLE, 5)
+    done = started and wait(lambda: s.interp_state == linuxcnc.INTERP_IDLE and s.queue == 0, limit_s)
+    time.sleep(0.3)
+    rec.terminate()
+    rec.wait()
+err = linuxcnc.error_channel().poll()
+if err:
+    fail("LinuxCNC error: " + str(err[1]))
+if not done:
+    fail("program did not start" if not started else "program did not finish in %g s" % limit_s)
+with open(out + ".status", "w") as f:
+    f.write("ok\n")
