@@ -21,6 +21,9 @@ struct PlaneAxes {
 };
 [[nodiscard]] PlaneAxes plane_axes(Plane p) noexcept;
 
+// G64 P in effect before the program sets one [mm] (0.001 inch).
+inline constexpr double kPowerUpBlendTolMm = 0.0254;
+
 // At most this many chords per arc; more is reported as an error (keeps runaway input bounded).
 inline constexpr long kMaxArcChords = 1000000;
 
@@ -71,8 +74,10 @@ class PathBuilder {
   AxisVector pos_{};
   int tool_ = 0;
   double length_ = 0.0;
-  PathControl control_ = PathControl::Blend;  // LinuxCNC starts in G64 without tolerance
-  double blend_tol_mm_ = 0.0, naive_tol_mm_ = 0.0;
+  // Before any G61/G64 the program blends within 0.001 inch, as LinuxCNC's planner was
+  // measured to do (docs/nc-frontend.md#planner); an explicit G64 without P has no P bound.
+  PathControl control_ = PathControl::Blend;
+  double blend_tol_mm_ = kPowerUpBlendTolMm, naive_tol_mm_ = 0.0;
 };
 
 }  // namespace lbr::nc::detail

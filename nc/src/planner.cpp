@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -163,24 +164,50 @@ struct Corner {
   double arc_length = 0.0, v_arc = 0.0, a_arc = 0.0;
 };
 
-// 1 / cos(x) - 1 without cancellation for small x.
-double sec_minus_one(double x) {
-  const double s = std::sin(0.5 * x);
-  return 2.0 * s * s / std::cos(x);
+// The arc's plane bounds: total acceleration A and speed from the axis limits (see the top).
+void plane_bounds(const AxisVector& u, const AxisVector& normal, const EmulatorLimits& l, double& acc, double& vel) {
+  acc = std::numeric_limits<double>::infinity();
+  vel = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < kAxes; ++a) {
+    const double g = std::hypot(u[a], normal[a]);
+    if (g < 1e-15) continue;
+    acc = std::min(acc, l.max_accel[a] / g);
+    vel = std::min(vel, l.max_velocity[a] / 60.0 / g);
+  }
+}
+
+// Blend size as LinuxCNC's planner computes it (blendmath.c: tcFindBlendTolerance,
+// blendComputeParameters): tolerance T = min(P, L1/4, L2/4) (P = 0: no P bound), at most half
+// of each move, the arc as small as the cornering speed needs but not smaller than a
+// parabolic blend of the same speed would take.
+double blend_radius(const Move& m, const Move& n, double phi, double a_max, double a_n, double v_goal, double& v_plan) {
+  const double theta = 0.5 * (std::numbers::pi - phi);  // half the angle between the moves
+  double tol = 0.25 * std::min(m.length, n.length);
+  for (const Move* k : {&m, &n})
+    if (k->seg->blend_tol_mm > 0.0) tol = std::min(tol, k->seg->blend_tol_mm);
+  const double d_tol = std::cos(theta) * tol / (1.0 - std::sin(theta));
+  const double d_geom = std::min({0.5 * m.length, 0.5 * n.length, d_tol});
+  const double r_geom = std::tan(theta) * d_geom;
+  v_plan = std::min(std::sqrt(a_n * r_geom), v_goal);
+  const double a_parabolic = 0.5 * a_max;
+  const double t_blend = std::min(std::sqrt(2.0 * a_parabolic * d_geom), v_plan) / a_parabolic;
+  const double r_blend = std::min(t_blend * v_plan / phi, r_geom);
+  return std::max(v_plan * v_plan / a_n, r_blend);
 }
 
 void blend_arc(const Move& m, const Move& n, double cos_phi, const EmulatorLimits& l, Corner& c) {
   const double phi = std::acos(std::clamp(cos_phi, -1.0, 1.0));
-  const double tan_half = std::tan(0.5 * phi);
-  double radius = 0.5 * std::min(m.length, n.length) / tan_half;
-  const double tol = m.seg->blend_tol_mm;
-  if (tol > 0.0) radius = std::min(radius, tol / sec_minus_one(0.5 * phi));
-  if (!(radius > kMinLength)) return;  // stop
   AxisVector normal{};
   for (int a = 0; a < kAxes; ++a) normal[a] = n.u[a] - cos_phi * m.u[a];
   const double nn = std::sqrt(dot(normal, normal));
   for (int a = 0; a < kAxes; ++a) normal[a] /= nn;
-  c.trim = radius * tan_half;
+  double acc = 0.0, vel = 0.0;
+  plane_bounds(m.u, normal, l, acc, vel);
+  const double a_n = kNormalShare * acc;
+  double v_plan = 0.0;
+  const double radius = blend_radius(m, n, phi, acc, a_n, std::min({vel, m.v_nom, n.v_nom}), v_plan);
+  if (!(radius > kMinLength) || !(v_plan > 0.0)) return;  // stop
+  c.trim = radius * std::tan(0.5 * phi);
   c.arc = true;
   c.stop = false;
   c.arc_length = radius * phi;
@@ -190,16 +217,9 @@ void blend_arc(const Move& m, const Move& n, double cos_phi, const EmulatorLimit
     c.geom.e2[a] = m.u[a];
   }
   c.geom.radius = radius;
-  double acc = std::numeric_limits<double>::infinity(), vel = std::min(m.v_nom, n.v_nom);
-  for (int a = 0; a < kAxes; ++a) {
-    const double g = std::hypot(m.u[a], normal[a]);
-    if (g < 1e-15) continue;
-    acc = std::min(acc, l.max_accel[a] / g);
-    vel = std::min(vel, l.max_velocity[a] / 60.0 / g);
-  }
-  c.geom.normal_accel = kNormalShare * acc;
+  c.geom.normal_accel = a_n;
   c.a_arc = kTangentialShare * acc;
-  c.v_arc = std::min(vel, std::sqrt(c.geom.normal_accel * radius));
+  c.v_arc = v_plan;
 }
 
 Corner corner_after(const Move& m, const Move* next, const EmulatorLimits& l) {
@@ -207,6 +227,8 @@ Corner corner_after(const Move& m, const Move* next, const EmulatorLimits& l) {
   if (m.hold || next == nullptr || next->hold) return c;
   const PathControl pc = m.seg->path_control;
   if (pc == PathControl::ExactStop) return c;
+  // A rapid and a feed are never blended (nor is speed carried over), as in LinuxCNC.
+  if ((m.seg->kind == SegmentKind::Rapid) != (next->seg->kind == SegmentKind::Rapid)) return c;
   const double cos_phi = dot(m.u, next->u);
   if (cos_phi >= kCollinearCos) {
     c.stop = false;  // collinear: straight on

@@ -10,13 +10,17 @@ import linuxcnc
 
 prog, out = os.environ["LREF_PROG"], os.environ["LREF_OUT"]
 limit_s = float(os.environ.get("LREF_LIMIT_S", "120"))
-s, c = linuxcnc.stat(), linuxcnc.command()
+s, c, e = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
+errors = []
 
 
 def wait(cond, limit_s):
     t0 = time.time()
     while time.time() - t0 < limit_s:
         s.poll()
+        msg = e.poll()
+        if msg:
+            errors.append(str(msg[1]))
         if cond():
             return True
         time.sleep(0.005)
@@ -55,10 +59,10 @@ with open(out, "w") as f:
     time.sleep(0.3)
     rec.terminate()
     rec.wait()
-err = linuxcnc.error_channel().poll()
-if err:
-    fail("LinuxCNC error: " + str(err[1]))
+if errors:
+    fail("LinuxCNC error: " + "; ".join(errors))
 if not done:
-    fail("program did not start" if not started else "program did not finish in %g s" % limit_s)
+    fail(("program did not start" if not started else "program did not finish in %g s" % limit_s) +
+         "; ".join([""] + errors) + " (interp %d, exec %d, queue %d)" % (s.interp_state, s.exec_state, s.queue))
 with open(out + ".status", "w") as f:
     f.write("ok\n")
