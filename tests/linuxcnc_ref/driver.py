@@ -9,7 +9,7 @@ import time
 import linuxcnc
 
 prog, out = os.environ["LREF_PROG"], os.environ["LREF_OUT"]
-limit_s = float(os.environ.get("LREF_LIMIT_S", "120"))
+limit_s = float(os.environ.get("LREF_LIMIT_S", "600"))
 s, c, e = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
 errors = []
 
@@ -34,13 +34,13 @@ def fail(what):
     sys.exit(1)
 
 
-for attempt in range(5):  # task may still be starting: ask again
+for attempt in range(10):  # task may still be starting (slowly on a loaded machine): ask again
     wait(lambda: False, 1.0)
     c.state(linuxcnc.STATE_ESTOP_RESET)
-    c.wait_complete(5)
+    c.wait_complete(10)
     c.state(linuxcnc.STATE_ON)
-    c.wait_complete(5)
-    if wait(lambda: s.task_state == linuxcnc.STATE_ON, 5):
+    c.wait_complete(10)
+    if wait(lambda: s.task_state == linuxcnc.STATE_ON, 10):
         break
 else:
     fail("machine did not switch on (task_state %d, estop %d)" % (s.task_state, s.estop))

@@ -2,7 +2,8 @@
 # Runs a G-code program on LinuxCNC's simulated machine without a display and writes the
 # commanded X Y Z of every 1 ms servo period to OUT ("SAMPLE X Y Z" per line, mm).
 # Usage: run_ref.sh PROGRAM OUT. Exit 77 when LinuxCNC is not installed. LREF_LIMIT_S: the
-# longest the program may run (default 120 s).
+# longest the program may run in wall time (default 600 s; a loaded machine runs the simulator
+# slower than real time, the samples stay 1 ms apart in motion time).
 # Used by tests/nc_emulator_linuxcnc_test.cpp (docs/nc-frontend.md#linuxcnc-reference).
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
