@@ -136,6 +136,7 @@ bool mergeable(const Move& a, const Move& b) {
 
 // Step 2: G64 Q — runs of feeds whose vertices stay within Q of the chord become the chord.
 std::vector<Move> merge_naive_cam(const Toolpath& path, std::vector<Move> moves, const EmulatorLimits& l) {
+  if (std::none_of(moves.begin(), moves.end(), [](const Move& m) { return m.seg->naive_tol_mm > 0.0; })) return moves;
   std::vector<Move> out;
   out.reserve(moves.size());
   std::size_t k = 0;
