@@ -27,6 +27,23 @@ def wait(cond, limit_s):
     return False
 
 
+still = {"pos": None, "since": 0.0, "moved": False}
+
+
+def finished():
+    # The interpreter goes idle at M2; now and then it stays "reading" after the last move
+    # has run (seen on a loaded machine), so an empty motion queue with the position still
+    # for 3 s after the program moved also ends the run (the reference programs do not dwell).
+    if s.interp_state == linuxcnc.INTERP_IDLE and s.queue == 0:
+        return True
+    pos = tuple(s.position[:3])
+    if pos != still["pos"]:
+        still["moved"] = still["pos"] is not None
+        still["pos"], still["since"] = pos, time.time()
+        return False
+    return still["moved"] and s.queue == 0 and time.time() - still["since"] > 3.0
+
+
 def fail(what):
     # LinuxCNC sends a display's output to a log it deletes: the verdict goes to OUT.status.
     with open(out + ".status", "w") as f:
@@ -55,7 +72,7 @@ with open(out, "w") as f:
     time.sleep(0.3)
     c.auto(linuxcnc.AUTO_RUN, 0)
     started = wait(lambda: s.interp_state != linuxcnc.INTERP_IDLE, 5)
-    done = started and wait(lambda: s.interp_state == linuxcnc.INTERP_IDLE and s.queue == 0, limit_s)
+    done = started and wait(finished, limit_s)
     time.sleep(0.3)
     rec.terminate()
     rec.wait()
