@@ -6,3 +6,6 @@ target_compile_definitions(app_view_stream_test PRIVATE LBR_SOURCE_DIR="${PROJEC
 # (white-box: the live pipeline's private headers in app/src/live/).
 lbr_test(app_live_alloc_test app_live_alloc_test.cpp alloc_counter.cpp)
 target_include_directories(app_live_alloc_test PRIVATE ${PROJECT_SOURCE_DIR}/app/src)
+# Emulator blending against exact stop through the kernel (docs/nc-frontend.md#planner).
+lbr_test(app_emulator_blend_test app_emulator_blend_test.cpp)
+target_compile_definitions(app_emulator_blend_test PRIVATE LBR_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -1,5 +1,7 @@
 #include "nc/emulator.hpp"
 
+#include "planner.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -21,78 +23,15 @@ std::string validate(const EmulatorLimits& l) {
   return "";
 }
 
-namespace {
-[[noreturn]] void invalid(const Toolpath& p, int line, const std::string& m) {
-  throw std::invalid_argument(p.source + ":" + std::to_string(line) + ": " + m);
-}
-}  // namespace
-
 Emulator::Emulator(const Toolpath& path, const EmulatorLimits& l) {
   if (const std::string e = validate(l); !e.empty()) throw std::invalid_argument("emulator limits: " + e);
   period_s_ = l.sample_period_ms * 1e-3;
   start_ = path.start;
   start_tool_ = path.start_tool;
-  plans_.reserve(path.segments.size());
-  AxisVector pos = path.start;
-  double t = 0.0;
-  for (const Segment& s : path.segments) {
-    Plan p;
-    p.from = pos;
-    p.to = s.end;
-    p.t0_s = t;
-    p.tool = s.tool;
-    p.line = s.line;
-    switch (s.kind) {
-      case SegmentKind::Rapid:
-      case SegmentKind::Feed: {
-        AxisVector d{};
-        for (int a = 0; a < kAxes; ++a) d[a] = s.end[a] - pos[a];
-        double len = std::hypot(d[X], d[Y], d[Z]);
-        if (!(len > 1e-12)) len = std::hypot(d[A], d[B], d[C]);
-        if (!std::isfinite(len)) invalid(path, s.line, "non-finite position");
-        if (len > 1e-12) {
-          double v = 0.0;  // [unit/s]
-          if (s.kind == SegmentKind::Rapid) {
-            v = l.rapid_mm_per_min / 60.0;
-          } else {
-            if (!(s.feed_mm_per_min > 0.0) || !std::isfinite(s.feed_mm_per_min))
-              invalid(path, s.line, "feed segment without a positive feed rate");
-            double f = s.feed_mm_per_min;
-            if (l.max_feed_mm_per_min > 0.0) f = std::min(f, l.max_feed_mm_per_min);
-            v = f / 60.0;
-          }
-          double acc = std::numeric_limits<double>::infinity();
-          for (int a = 0; a < kAxes; ++a) {
-            const double u = std::abs(d[a]) / len;
-            if (u < 1e-15) continue;
-            v = std::min(v, l.max_velocity[a] / 60.0 / u);
-            acc = std::min(acc, l.max_accel[a] / u);
-          }
-          p.length = len;
-          if (len >= v * v / acc) {
-            p.v = v;
-            p.t_acc_s = v / acc;
-            p.duration_s = len / v + v / acc;
-          } else {  // triangular profile: never reaches cruise speed
-            p.t_acc_s = std::sqrt(len / acc);
-            p.v = acc * p.t_acc_s;
-            p.duration_s = 2.0 * p.t_acc_s;
-          }
-          p.a = acc;
-        }
-        break;
-      }
-      case SegmentKind::Dwell:
-        if (!(s.dwell_s >= 0.0) || !std::isfinite(s.dwell_s)) invalid(path, s.line, "dwell time must be >= 0 s");
-        p.duration_s = s.dwell_s;
-        break;
-      case SegmentKind::ToolChange: p.duration_s = l.tool_change_s; break;
-    }
-    t += p.duration_s;
-    pos = s.end;
-    plans_.push_back(p);
-  }
-  total_s_ = t;
+  detail::PlannedPath planned = detail::plan_path(path, l);
+  plans_ = std::move(planned.plans);
+  arcs_ = std::move(planned.arcs);
+  total_s_ = planned.total_s;
   const double n = std::ceil(total_s_ / period_s_);
   if (n > 1e15) throw std::invalid_argument(path.source + ": program too long for the sample period");
   count_ = static_cast<std::uint64_t>(n);
@@ -100,22 +39,7 @@ Emulator::Emulator(const Toolpath& path, const EmulatorLimits& l) {
 
 void Emulator::eval(std::size_t i, double t_s, AxisVector& axes) const noexcept {
   const Plan& p = plans_[i];
-  if (p.length <= 0.0) {
-    axes = p.to;
-    return;
-  }
-  const double tau = std::clamp(t_s - p.t0_s, 0.0, p.duration_s);
-  double s = 0.0;
-  if (tau < p.t_acc_s) {
-    s = 0.5 * p.a * tau * tau;
-  } else if (tau <= p.duration_s - p.t_acc_s) {
-    s = 0.5 * p.a * p.t_acc_s * p.t_acc_s + p.v * (tau - p.t_acc_s);
-  } else {
-    const double r = p.duration_s - tau;
-    s = p.length - 0.5 * p.a * r * r;
-  }
-  const double k = std::clamp(s / p.length, 0.0, 1.0);
-  for (int a = 0; a < kAxes; ++a) axes[a] = p.from[a] + k * (p.to[a] - p.from[a]);
+  detail::piece_position(p, arcs_, detail::piece_distance(p, t_s - p.t0_s), axes);
 }
 
 bool Emulator::next(Sample& out) noexcept {

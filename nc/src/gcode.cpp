@@ -506,15 +506,20 @@ class Interpreter {
       else k = 6 + (c - 591);
       select_wcs(k);
     }
-    // kPath: G61/G61.1/G64 [P tolerance] [Q naive-cam tolerance] are recorded; the emulator
-    // stops exactly at corners (docs/nc-frontend.md#motion-model).
+    // kPath: G61/G61.1/G64 [P tolerance] [Q naive-cam tolerance] go on the segments; the
+    // emulator's planner reads them (docs/nc-frontend.md#planner). As in LinuxCNC, G64 without
+    // P blends without a tolerance and Q defaults to P.
     if (gw[kPath]) {
       path_mode_ = code10(*gw[kPath]);
       if (path_mode_ == 640) {
-        if (has(b, 'P')) path_tol_mm_ = len(b, 'P');
-        if (has(b, 'Q')) path_q_tol_mm_ = len(b, 'Q');
+        path_tol_mm_ = has(b, 'P') ? len(b, 'P') : 0.0;
+        path_q_tol_mm_ = has(b, 'Q') ? len(b, 'Q') : path_tol_mm_;
         if (path_tol_mm_ < 0.0 || path_q_tol_mm_ < 0.0) fail("'G64' tolerances P and Q must be >= 0");
       }
+      const PathControl c = path_mode_ == 640 ? PathControl::Blend
+                            : path_mode_ == 610 ? PathControl::ExactPath
+                                                : PathControl::ExactStop;
+      b_.set_path_control(c, path_tol_mm_, path_q_tol_mm_);
     }
     if (gw[kDistance]) absolute_ = code10(*gw[kDistance]) == 900;
     if (gw[kArcDistance]) arc_absolute_ = code10(*gw[kArcDistance]) == 901;

@@ -59,6 +59,9 @@ void PathBuilder::push(SegmentKind k, int line, const AxisVector& end_program, d
   s.dwell_s = dwell_s;
   s.tool = tool_;
   s.line = line;
+  s.path_control = control_;
+  s.blend_tol_mm = blend_tol_mm_;
+  s.naive_tol_mm = naive_tol_mm_;
   tp_.segments.push_back(s);
 }
 

@@ -21,6 +21,9 @@ struct PlaneAxes {
 };
 [[nodiscard]] PlaneAxes plane_axes(Plane p) noexcept;
 
+// G64 P in effect before the program sets one [mm] (0.001 inch).
+inline constexpr double kPowerUpBlendTolMm = 0.0254;
+
 // At most this many chords per arc; more is reported as an error (keeps runaway input bounded).
 inline constexpr long kMaxArcChords = 1000000;
 
@@ -50,6 +53,10 @@ class PathBuilder {
   // < 0 clockwise, |rotation| - 1 extra full turns. The radius may change linearly (spiral).
   void arc(int line, Plane p, const AxisVector& end, double cu, double cv, int rotation, double feed,
            bool inverse_time);
+  // Path control stamped on the segments that follow (G61 / G61.1 / G64 P Q).
+  void set_path_control(PathControl c, double blend_tol_mm, double naive_tol_mm) {
+    control_ = c, blend_tol_mm_ = blend_tol_mm, naive_tol_mm_ = naive_tol_mm;
+  }
   void dwell(int line, double seconds);
   void tool_change(int line, int tool);
 
@@ -67,6 +74,10 @@ class PathBuilder {
   AxisVector pos_{};
   int tool_ = 0;
   double length_ = 0.0;
+  // Before any G61/G64 the program blends within 0.001 inch, as LinuxCNC's planner was
+  // measured to do (docs/nc-frontend.md#planner); an explicit G64 without P has no P bound.
+  PathControl control_ = PathControl::Blend;
+  double blend_tol_mm_ = kPowerUpBlendTolMm, naive_tol_mm_ = 0.0;
 };
 
 }  // namespace lbr::nc::detail

@@ -136,6 +136,8 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
   double feed = 0.0;
   const bool inverse = false;  // SET_FEED_RATE is always in length units per minute
   int selected = options.start_tool;
+  PathControl path = PathControl::Blend;
+  double path_p_mm = 0.0, path_q_mm = 0.0;
   int line = 0;
   std::istringstream in(canon);
   std::string raw;
@@ -246,6 +248,13 @@ Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, co
       need(v, 1, cmd);
       selected = static_cast<int>(std::lround(v[0]));
       b.tool_change(line, selected);
+    } else if (cmd == "SET_MOTION_CONTROL_MODE" || cmd == "SET_NAIVECAM_TOLERANCE") {
+      // G61 / G61.1 / G64 P (CANON_CONTINUOUS, tolerance) and G64 Q, for the emulator's planner.
+      const auto v = numbers(c.args);
+      if (cmd == "SET_NAIVECAM_TOLERANCE") need(v, 1, cmd), path_q_mm = v[0] * scale;
+      else if (c.args.find("CONTINUOUS") != std::string::npos) path = PathControl::Blend, path_p_mm = v.empty() ? 0.0 : v[0] * scale;
+      else path = c.args.find("EXACT_PATH") != std::string::npos ? PathControl::ExactPath : PathControl::ExactStop;
+      b.set_path_control(path, path_p_mm, path_q_mm);
     } else if (cmd == "SELECT_PLANE") {
       if (c.args.find("XZ") != std::string::npos) plane = Plane::ZX;
       else if (c.args.find("YZ") != std::string::npos) plane = Plane::YZ;

@@ -576,8 +576,12 @@ std::string finish5x(long& moves) {
   return p.out.str();
 }
 
+// Timed with exact stop after every block (G61.1), the emulator's model when the programs were
+// calibrated: the committed programs stay as they are now that the emulator blends
+// (docs/benchmarks.md).
 double emulated_time(const std::string& text, const Profile& prof) {
-  const lbr::nc::Toolpath tp = lbr::nc::interpret_gcode(text, "gen", lbr::app::gcode_options(prof));
+  lbr::nc::Toolpath tp = lbr::nc::interpret_gcode(text, "gen", lbr::app::gcode_options(prof));
+  for (lbr::nc::Segment& s : tp.segments) s.path_control = lbr::nc::PathControl::ExactStop;
   return lbr::nc::emulated_time_s(tp, lbr::app::emulator_limits(prof));
 }
 

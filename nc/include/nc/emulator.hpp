@@ -1,12 +1,14 @@
 // nc/emulator.hpp — machine emulator: a Toolpath as a controller would execute and report it.
 //
-// Motion model (docs/nc-frontend.md#emulator): every Rapid/Feed segment is a straight line in
-// X Y Z A B C run with a trapezoidal velocity profile that starts and ends at rest (exact stop
-// at every corner, no blending). The path speed is the programmed feed (rapid rate for
-// Rapid), lowered so that no axis exceeds its velocity limit; the path acceleration is the
-// largest at which no axis exceeds its acceleration limit. Dwell and ToolChange hold the
-// position for dwell_s / tool_change_s. The path parameter is the XYZ length [mm], or the
-// rotary length [deg] for rotary-only moves (their feed is then read as deg/min).
+// Motion model (docs/nc-frontend.md#planner): a look-ahead trajectory planner in X Y Z A B C.
+// Moves under G64 are joined by tangent circular blend arcs (corner deviation <= the G64 P
+// tolerance, collinear runs within Q merged), G61 stops at corners, G61.1 and move lists stop
+// after every move. A backward and a forward velocity pass over the whole program give every
+// piece (line, blend arc) a trapezoidal speed profile that keeps each axis within its velocity
+// and acceleration limits and can stop within the remaining path. The path parameter is the
+// X Y Z A B C length [mm, deg counted as mm]; the programmed feed is the XYZ speed (the rotary
+// speed for rotary-only moves, deg/min). Dwell and ToolChange hold the position for dwell_s /
+// tool_change_s.
 //
 // Samples are taken every period at t = (seq + 1) * period, seq = 0, 1, ...; the last one is
 // the first at or after the end of the program, so count * period - total time is in
@@ -59,24 +61,39 @@ class Emulator {
   // Position and tool at time t [s] (clamped to [0, total]). Real-time safe; O(log n).
   void state_at(double t_s, AxisVector& axes, int& tool) const noexcept;
 
-  // Planned motion of one segment (exposed for tests and tools).
+  // One planned piece of motion (exposed for tests and tools): a Hold (dwell, tool change), a
+  // Line from `from` to `to`, or an Arc (blend) whose geometry is arcs()[arc].
+  enum class PieceKind : unsigned char { Hold, Line, Arc };
   struct Plan {
+    PieceKind kind = PieceKind::Hold;
     AxisVector from{}, to{};
     double t0_s = 0.0;        // start time [s]
     double duration_s = 0.0;  // [s]
-    double length = 0.0;      // path parameter length [mm or deg]
-    double v = 0.0;           // cruise speed [unit/s]
-    double a = 0.0;           // acceleration [unit/s²]
-    double t_acc_s = 0.0;     // acceleration phase (= deceleration phase) [s]
-    int tool = 0;             // tool during the segment
-    int line = 0;
+    double length = 0.0;      // path parameter length [mm, deg]
+    double v_in = 0.0;        // speed at the start [unit/s]
+    double v = 0.0;           // peak (cruise) speed [unit/s]
+    double v_out = 0.0;       // speed at the end [unit/s]
+    double a = 0.0;           // tangential acceleration [unit/s²]
+    double t_acc_s = 0.0;     // v_in -> v [s]
+    double t_dec_s = 0.0;     // v -> v_out [s]
+    int arc = -1;             // Arc: index into arcs()
+    int tool = 0;             // tool during the piece
+    int line = 0;             // source line (a blend arc: the line of the move it leaves)
   };
+  // Blend arc: position at path length s is centre + radius (cos(s/r) e1 + sin(s/r) e2).
+  struct ArcGeom {
+    AxisVector centre{}, e1{}, e2{};
+    double radius = 0.0;
+    double normal_accel = 0.0;  // centripetal acceleration allowed on it [unit/s²]
+  };
+  [[nodiscard]] const std::vector<ArcGeom>& arcs() const noexcept { return arcs_; }
   [[nodiscard]] const std::vector<Plan>& plans() const noexcept { return plans_; }
 
  private:
   void eval(std::size_t i, double t_s, AxisVector& axes) const noexcept;
 
   std::vector<Plan> plans_;
+  std::vector<ArcGeom> arcs_;
   AxisVector start_{};
   int start_tool_ = 0;
   double period_s_ = 0.004;

@@ -26,6 +26,14 @@ enum class SegmentKind : unsigned char {
 
 [[nodiscard]] const char* to_string(SegmentKind k) noexcept;
 
+// Path control in effect for a move (docs/nc-frontend.md#planner): how the machine emulator
+// passes the corner at the move's end.
+enum class PathControl : unsigned char {
+  ExactStop,  // G61.1: stop at the end of every move (also move lists, which have no such word)
+  ExactPath,  // G61: stop at corners, keep speed through exactly collinear moves
+  Blend,      // G64 [P] [Q]: blend corners within blend_tol_mm, keep speed through tangent runs
+};
+
 struct Segment {
   SegmentKind kind = SegmentKind::Feed;
   AxisVector end{};                       // axis positions at the end of the segment
@@ -35,6 +43,9 @@ struct Segment {
   double dwell_s = 0.0;                   // Dwell only
   int tool = 0;                           // tool in the spindle during (after) the segment
   int line = 0;                           // 1-based source line
+  PathControl path_control = PathControl::ExactStop;
+  double blend_tol_mm = 0.0;              // G64 P: corner deviation bound [mm]; 0: none
+  double naive_tol_mm = 0.0;              // G64 Q: collinear feeds within this merge [mm]; 0: off
 };
 
 struct Toolpath {
