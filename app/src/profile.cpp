@@ -10,6 +10,7 @@
 
 #include <toml++/toml.h>
 
+#include "app/install_paths.hpp"
 #include "hal/sample.hpp"
 
 #include "default_profile.inc"  // kDefaultProfileToml, generated from config/profiles/default-mill3.toml
@@ -220,6 +221,7 @@ void read_live(Section& top, Profile& p, const std::string& name) {
     L.geometry_duty = s.number("geometry_duty", 0.7, 0.1, 1.0, "fraction");
     L.jump_tolerance = s.number("jump_tolerance", 1.5, 1.0, 100.0, "factor");
     L.merge_tolerance_mm = s.number("merge_tolerance_mm", 0.001, 0.0, 1.0, "mm");
+    p.live_snapshot_s = s.number("snapshot_s", 5.0, 0.0, 86400.0, "s");  // app/snapshot.hpp
     if (const toml::table* st = s.table("serial")) {
       Section ss(*st, "live.serial", name);
       L.serial.baud = static_cast<int>(ss.integer("baud", 115200, 1200, 4000000));
@@ -232,6 +234,7 @@ void read_live(Section& top, Profile& p, const std::string& name) {
       L.can.sync_counter_max = static_cast<int>(cs.integer("sync_counter_max", 240, 2, 255));
       L.can.late_ms = cs.number("late_ms", 0.0, 0.0, 1000.0, "ms");
       L.can.reconnect_ms = cs.number("reconnect_ms", 500.0, 1.0, 60000.0, "ms");
+      p.live_can_bitrate = static_cast<int>(cs.integer("bitrate", 500000, 10000, 1000000));  // lbrsim-can@.service
       cs.reject_unknown();
     }
     if (const toml::node* an = s.get("axis")) {
@@ -507,7 +510,8 @@ Profile parse_profile(const std::string& text, const std::string& name) {
   return p;
 }
 
-Profile load_profile(const std::string& path) {
+Profile load_profile(const std::string& path_as_given) {
+  const std::string path = find_profile(path_as_given);  // then /etc/lbrsim (app/install_paths.hpp)
   std::ifstream f(path, std::ios::binary);
   if (!f) throw ProfileError(path + ":0: cannot open profile");
   std::ostringstream ss;

@@ -51,6 +51,8 @@ struct Profile {
   std::map<int, geom::Tool> tools;             // milling tools (spindle or live tools)
   double render_rate_hz = 30.0;  // [render] rate_hz: the render thread's fixed frame rate
   hal::LiveConfig live;     // [live], [[live.axis]], [threads]: `lbrsim run` (docs/profiles.md)
+  double live_snapshot_s = 5.0;   // [live] snapshot_s: power-loss snapshot period [s]; 0: none (docs/snapshot.md)
+  int live_can_bitrate = 500000;  // [live.can] bitrate [bit/s]: for setting up the interface (docs/deployment.md)
   // Machine kinematics ([machine] kind, rotary, ... in docs/profiles.md).
   kin::Kinematics kin;
   bool diameter_programming = true;            // lathe kinds: X words are diameters (G7)
