@@ -479,14 +479,13 @@ std::optional<app::SnapshotState> resume_snapshot(const RunOptions& o) {
 // The systemd watchdog (app/watchdog.hpp): probes on the HAL, geometry and render threads.
 std::vector<app::ProgressProbe> live_probes(const app::LiveProgress& pr) {
   using C = std::optional<std::uint64_t>;
-  return {
-      {"hal thread", [&pr]() -> C { return pr.hal_running.load() ? C(pr.hal_loops.load()) : std::nullopt; }},
-      {"geometry thread", [&pr]() -> C { return pr.geometry_running.load() ? C(pr.geometry_loops.load()) : std::nullopt; }},
-      {"render thread", []() -> C {
-         const std::lock_guard<std::mutex> lock(g_render_mu);
-         return g_render_thread != nullptr && g_render_thread->running() ? C(g_render_thread->frames_done()) : std::nullopt;
-       }, false},
-  };
+  std::vector<app::ProgressProbe> probes = app::live_progress_probes(pr);
+  probes.push_back({"render thread", []() -> C {
+                      const std::lock_guard<std::mutex> lock(g_render_mu);
+                      return g_render_thread != nullptr && g_render_thread->running() ? C(g_render_thread->frames_done())
+                                                                                      : std::nullopt;
+                    }, false});
+  return probes;
 }
 
 int run_live_command(RunOptions o) {

@@ -2,6 +2,8 @@
 // rule that the watchdog is petted only while the live threads make progress.
 #include "app/watchdog.hpp"
 
+#include "app/live.hpp"
+
 #include <systemd/sd-daemon.h>
 
 #include <chrono>
@@ -50,6 +52,15 @@ bool ProgressWatchdog::check() {
   n_.notify("WATCHDOG=1");
   ++pets_;
   return true;
+}
+
+std::vector<ProgressProbe> live_progress_probes(const LiveProgress& pr) {
+  using C = std::optional<std::uint64_t>;
+  return {
+      {"hal thread", [&pr]() -> C { return pr.hal_running.load() ? C(pr.hal_loops.load()) : std::nullopt; }, true},
+      {"geometry thread", [&pr]() -> C { return pr.geometry_running.load() ? C(pr.geometry_loops.load()) : std::nullopt; },
+       true},
+  };
 }
 
 WatchdogThread::WatchdogThread(ProgressWatchdog& w, std::int64_t period_ms) {

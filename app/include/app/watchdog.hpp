@@ -70,6 +70,10 @@ class ProgressWatchdog {
   std::string stalled_;  // names of the stalled threads ("" when none)
 };
 
+struct LiveProgress;  // app/live.hpp
+// Probes on the live pipeline's HAL and geometry threads (both needed for READY=1).
+[[nodiscard]] std::vector<ProgressProbe> live_progress_probes(const LiveProgress& progress);
+
 // Runs watchdog.check() every `period_ms` until stop() (or destruction).
 class WatchdogThread {
  public:
