@@ -148,3 +148,15 @@ TEST(Snapshot, NoSnapshotInAnEmptyFolder) {
   EXPECT_FALSE(l.state);
   EXPECT_TRUE(l.problems.empty());
 }
+
+TEST(Snapshot, ProfileKeysForSnapshotsAndTheCanBitrate) {
+  const app::Profile d = app::default_profile();
+  EXPECT_DOUBLE_EQ(d.live_snapshot_s, 5.0);
+  EXPECT_EQ(d.live_can_bitrate, 500000);
+  const std::string base = app::default_profile_text();
+  const app::Profile p = app::parse_profile(base + "\n[live]\nsnapshot_s = 0.5\n[live.can]\nbitrate = 250000\n", "p.toml");
+  EXPECT_DOUBLE_EQ(p.live_snapshot_s, 0.5);
+  EXPECT_EQ(p.live_can_bitrate, 250000);
+  EXPECT_THROW((void)app::parse_profile(base + "\n[live]\nsnapshot_s = -1\n", "n.toml"), app::ProfileError);
+  EXPECT_THROW((void)app::parse_profile(base + "\n[live.can]\nbitrate = 5\n", "b.toml"), app::ProfileError);
+}

@@ -59,6 +59,8 @@ in_root() { chroot "$root" /bin/sh -c "cd /tmp && $*"; }
 version=$(in_root lbrsim --version)
 [ "$version" = "lbrsim $(basename "$deb" | cut -d_ -f2)" ] || fail "lbrsim --version says '$version'"
 in_root lbrsim profile live-6axis | grep -q "ok" || fail "/etc/lbrsim/live-6axis.toml not found by name"
+[ "$(in_root lbrsim profile live-6axis --can-bitrate)" = 500000 ] || fail "lbrsim profile live-6axis --can-bitrate"
+in_root test -f /lib/systemd/system/lbrsim@.service || fail "no lbrsim@.service"
 in_root test -f /usr/share/man/man1/lbrsim.1.gz || fail "no man page"
 in_root dpkg-query -W -f='\${Conffiles}' lbrsim | grep -q /etc/lbrsim/live-6axis.toml || fail "profiles are not conffiles"
 
