@@ -521,6 +521,7 @@ int run_live_command(RunOptions o) {
     gfx::set_display_lost_handler(on_display_lost);
     if (o.screenshot_prefix.empty()) std::filesystem::create_directories(o.out);  // screenshots go there
     const app::LiveResult r = run_live_rendered(o, profile, status);  // writes the results itself
+    notifier.notify("STOPPING=1");
     print_live_summary(o, r);
     return 0;
   }

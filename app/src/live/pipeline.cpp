@@ -338,8 +338,14 @@ void LivePipeline::configure() {
   p.backpressure = !p.src->live();
   p.ring = std::make_unique<sched::SpscRing<hal::AxisSample>>(cfg.ring_capacity);
   if (!p.opt.record.empty()) {
-    p.rec_file = std::fopen(p.opt.record.c_str(), "w");
+    // Resumed: the recording goes on in the same file, so snapshot offsets stay file offsets.
+    p.rec_file = std::fopen(p.opt.record.c_str(), resume != nullptr ? "a" : "w");
     if (p.rec_file == nullptr) throw std::runtime_error(p.opt.record + ": cannot open for writing");
+    if (resume != nullptr) {
+      std::error_code ec;
+      const auto size = std::filesystem::file_size(p.opt.record, ec);
+      p.rec_bytes.store(ec ? 0 : static_cast<std::uint64_t>(size), std::memory_order_relaxed);
+    }
     p.rec_ring = std::make_unique<sched::SpscRing<hal::RawRecord>>(1 << 15);
     p.src->set_recording(true);
   }
@@ -352,7 +358,7 @@ void LivePipeline::configure() {
     p.input = p.skip_sink.get();
   }
   p.geo = std::make_unique<Geometry>(p.r->solid, profile, *p.tools, cfg.tool, *p.ring, cfg.merge_tolerance_mm);
-  if (resume != nullptr) {
+  if (resume != nullptr && (emulator || replay)) {  // a live machine has moved on: no sweep across the outage
     std::array<hal::AxisSample, hal::kMaxChannels> last = resume->last;
     for (hal::AxisSample& s : last) s.seq = s.seq >= p.seq_base ? s.seq - p.seq_base : 0;
     p.geo->prime(resume->have, last);
