@@ -83,6 +83,7 @@ std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   j["rt_mode"] = r.rt_mode;
   j["snapshots_written"] = r.snapshots_written;
   j["snapshots_failed"] = r.snapshots_failed;
+  j["snapshot_copy_max_ms"] = r.snapshot_copy_max_ms;
   j["resumed_generation"] = r.resumed_generation;
   j["resumed_position"] = r.resumed_position;
   j["peak_rss_mb"] = peak_rss_mb();

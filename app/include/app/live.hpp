@@ -98,6 +98,7 @@ struct LiveResult {
   // Snapshots written (periodic and final) and failed; resumed: the snapshot's generation
   // and the source position it skipped to (0: not resumed).
   std::uint64_t snapshots_written = 0, snapshots_failed = 0, resumed_generation = 0, resumed_position = 0;
+  double snapshot_copy_max_ms = 0;  // longest copy of the solid into the writer's slot (geometry thread)
 };
 
 using StatusFn = std::function<void(const std::string& line)>;

@@ -51,6 +51,7 @@ struct LivePipeline::Impl {
   std::uint64_t seq_base = 0, applied_base = 0;
   double wall_base_s = 0;
   std::atomic<std::uint64_t> rec_bytes{0};  // written to the --record file so far
+  std::atomic<std::int64_t> snapshot_copy_max_ns{0};  // longest copy of the solid on the geometry thread
 
   // start() .. stop()
   std::atomic<bool> stop_requested{false};
@@ -151,9 +152,12 @@ void offer_snapshot(LivePipeline::Impl& p, std::int64_t& due_ns) {
   if (!p.snap || sched::now_ns() < due_ns) return;
   SnapshotState* s = p.snap->slot();
   if (s == nullptr) return;
+  const std::int64_t t0 = sched::now_ns();
   s->solid = p.r->solid;
   fill_snapshot(p, *s);
   p.snap->commit();
+  const std::int64_t took = sched::now_ns() - t0;
+  if (took > p.snapshot_copy_max_ns.load(std::memory_order_relaxed)) p.snapshot_copy_max_ns.store(took, std::memory_order_relaxed);
   due_ns = sched::now_ns() + p.snapshot_period_ns;
 }
 
@@ -455,6 +459,7 @@ LiveResult LivePipeline::result() {
       r.warnings.push_back(std::string("final snapshot not written: ") + e.what());
     }
     r.snapshots_written = p.snap->written();
+    r.snapshot_copy_max_ms = static_cast<double>(p.snapshot_copy_max_ns.load()) * 1e-6;
     r.snapshots_failed = p.snap->failed();
   }
   return std::move(r);
