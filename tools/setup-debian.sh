@@ -11,7 +11,9 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   # libraries (found by CMake find_package / pkg-config)
   libpolyclipping-dev libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
-  libglfw3-dev libx11-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev
+  libglfw3-dev libx11-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev libsystemd-dev
+  # Debian package (cmake --build build --target package) and its checks (ctest -L package)
+  lintian debootstrap
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
   # independent mesh checker for the exported STL (tests/cli_mesh_admesh.cmake)

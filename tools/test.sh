@@ -4,7 +4,8 @@
 # again (build-asan/); then the threaded tests (ring, RT threads, live pipeline, worker pool) under
 # ThreadSanitizer (build-tsan/) and,
 # where clang is installed, the libFuzzer decoder targets for a fixed number of runs
-# (build-fuzz/, label fuzz). Set LBR_SKIP_SANITIZERS=1 to skip these stages locally.
+# (build-fuzz/, label fuzz). Set LBR_SKIP_SANITIZERS=1 to skip these stages locally. Before
+# them, the Debian package test (label package; LBR_SKIP_PACKAGE=1 skips it).
 set -euo pipefail
 if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then  # usage: the comment above
   sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0
@@ -12,7 +13,13 @@ fi
 cd "$(dirname "$0")/.."
 tools/setup-debian.sh
 tools/build.sh -DLBR_BUILD_TESTS=ON
-ctest --test-dir build --output-on-failure --parallel "$(nproc)" --timeout 600
+ctest --test-dir build --output-on-failure --parallel "$(nproc)" --timeout 600 -LE package
+# The Debian package installed into a debootstrap root, and lintian (docs/deployment.md#tests;
+# skipped without root; ~5 min the first time, ~1.5 min with build/package-test cached).
+if [ "${LBR_SKIP_PACKAGE:-0}" != "1" ]; then
+  echo "== Debian package =="
+  ctest --test-dir build --output-on-failure -L package
+fi
 
 if [ "${LBR_SKIP_SANITIZERS:-0}" != "1" ]; then
   echo "== sanitizers: address,undefined =="

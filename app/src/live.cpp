@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/batch.hpp"
+#include "app/install_paths.hpp"
 #include "app/outputs.hpp"
 #include "geom/serialize.hpp"
 #include "sched/rt_thread.hpp"
@@ -47,6 +48,7 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
 
 std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   nlohmann::json j;
+  j["lbrsim_version"] = version();
   j["source"] = r.source;
   j["profile"] = profile.source;
   j["samples_received"] = r.samples_received;
@@ -79,6 +81,11 @@ std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   j["stop_latency_ms"] = r.stop_latency_ms;
   j["wall_time_s"] = r.wall_time_s;
   j["rt_mode"] = r.rt_mode;
+  j["snapshots_written"] = r.snapshots_written;
+  j["snapshots_failed"] = r.snapshots_failed;
+  j["snapshot_copy_max_ms"] = r.snapshot_copy_max_ms;
+  j["resumed_generation"] = r.resumed_generation;
+  j["resumed_position"] = r.resumed_position;
   j["peak_rss_mb"] = peak_rss_mb();
   return j.dump(2) + "\n";
 }

@@ -17,19 +17,18 @@
 #include <spdlog/spdlog.h>
 
 #include "app/batch.hpp"
+#include "app/install_paths.hpp"
 #include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
+#include "app/snapshot.hpp"
+#include "app/watchdog.hpp"
 #include "app/tune.hpp"
 #include "app/view.hpp"
 #include "gfx/viewer.hpp"
 #include "gfx/window.hpp"
 #include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
-
-#ifndef LBRSIM_VERSION
-#define LBRSIM_VERSION "dev"
-#endif
 
 namespace {
 
@@ -271,7 +270,18 @@ struct RunOptions {
   std::string screenshot_prefix;  // empty: OUT/frame-
   std::string view = "iso", color = "heat", size = "1280x800";
   double rate_hz = 0.0;  // 0: the profile's [render] rate_hz
+  // power-loss resume (docs/snapshot.md)
+  bool resume = false;
+  std::string snapshot_dir;  // empty: the --out folder
 };
+
+// The render thread of a rendered run, for the watchdog's probe (null when none runs).
+std::mutex g_render_mu;
+const gfx::RenderThread* g_render_thread = nullptr;
+void set_render_thread(const gfx::RenderThread* rt) {
+  const std::lock_guard<std::mutex> lock(g_render_mu);
+  g_render_thread = rt;
+}
 
 
 std::atomic<bool> g_stop{false};
@@ -425,6 +435,7 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
     gfx::RenderThread rt(win, ex, *start, rc);
     start.reset();
     rt.start();
+    set_render_thread(&rt);
     notice.attach(&rt);
     if (visible) {
       gfx::run_event_loop(win, rt, [&] { return !live_done.load(); });
@@ -438,6 +449,7 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
     // Show the final state for one more frame period before closing.
     std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(2000.0 / rc.rate_hz)));
     notice.attach(nullptr);
+    set_render_thread(nullptr);
     rt.stop();
     log_render_report(rt.report(), rc.rate_hz);
   }
@@ -460,13 +472,57 @@ void print_live_summary(const RunOptions& o, const app::LiveResult& r) {
               o.stl.empty() ? "" : ", ", o.stl.c_str(), o.ply.empty() ? "" : ", ", o.ply.c_str());
 }
 
+// --resume: the newest valid snapshot in the snapshot folder (a corrupt one is reported and
+// the other used); none: a new part.
+std::optional<app::SnapshotState> resume_snapshot(const RunOptions& o) {
+  if (!o.resume) return std::nullopt;
+  app::LoadedSnapshot l = app::load_newest_snapshot(o.live.snapshot_dir);
+  for (const std::string& p : l.problems) spdlog::warn("snapshot passed over: {}", p);
+  if (!l.state) {
+    spdlog::info("resume: no snapshot in {}; starting a new part", o.live.snapshot_dir);
+    return std::nullopt;
+  }
+  if (l.state->source != o.live.source)
+    throw std::runtime_error(l.file + ": snapshot of source '" + l.state->source + "', not '" + o.live.source +
+                             "'; start without --resume for a new part");
+  spdlog::info("resume: {} (generation {}, source sample {}, {} samples applied, {:.1f} s)", l.file, l.state->generation,
+               l.state->source_position, l.state->samples_applied, l.state->wall_time_s);
+  return std::move(l.state);
+}
+
+// The systemd watchdog (app/watchdog.hpp): probes on the HAL, geometry and render threads.
+std::vector<app::ProgressProbe> live_probes(const app::LiveProgress& pr) {
+  using C = std::optional<std::uint64_t>;
+  std::vector<app::ProgressProbe> probes = app::live_progress_probes(pr);
+  probes.push_back({"render thread", []() -> C {
+                      const std::lock_guard<std::mutex> lock(g_render_mu);
+                      return g_render_thread != nullptr && g_render_thread->running() ? C(g_render_thread->frames_done())
+                                                                                      : std::nullopt;
+                    }, false});
+  return probes;
+}
+
 int run_live_command(RunOptions o) {
   o.live.on_warning = [](const std::string& w) { spdlog::warn("{}", w); };
   const app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
   install_stop_handlers();
   spdlog::info("run: source {}, profile {}, period {} ms", o.live.source, profile.source, profile.live.period_ms);
-  app::StatusFn status;
-  if (!o.quiet) status = [](const std::string& line) { spdlog::info("{}", line); };
+  o.live.snapshot_dir = o.snapshot_dir.empty() ? o.out : o.snapshot_dir;
+  const std::optional<app::SnapshotState> resume = resume_snapshot(o);
+  if (resume) o.live.resume = &*resume;
+  app::SystemdNotifier notifier;
+  app::LiveProgress progress;
+  o.live.progress = &progress;
+  app::ProgressWatchdog watchdog(notifier, live_probes(progress));
+  std::optional<app::WatchdogThread> watchdog_thread;
+  if (notifier.active()) {
+    const std::int64_t wd_ms = static_cast<std::int64_t>(notifier.watchdog_us() / 3000);
+    watchdog_thread.emplace(watchdog, wd_ms > 0 ? std::min<std::int64_t>(wd_ms, 1000) : 1000);
+  }
+  app::StatusFn status = [quiet = o.quiet, &notifier](const std::string& line) {
+    if (!quiet) spdlog::info("{}", line);
+    notifier.notify("STATUS=" + line);
+  };
   // Rendering: a window (visible, or hidden for screenshots only) when a display exists.
   const bool want_render = o.screenshot_every > 0 || (!o.no_window && gfx::display_available());
   if (o.screenshot_every > 0 && !gfx::display_available())
@@ -479,10 +535,12 @@ int run_live_command(RunOptions o) {
     gfx::set_display_lost_handler(on_display_lost);
     if (o.screenshot_prefix.empty()) std::filesystem::create_directories(o.out);  // screenshots go there
     const app::LiveResult r = run_live_rendered(o, profile, status);  // writes the results itself
+    notifier.notify("STOPPING=1");
     print_live_summary(o, r);
     return 0;
   }
   const app::LiveResult r = app::run_live(profile, o.live, g_stop, status);
+  notifier.notify("STOPPING=1");
   write_live_results(o, profile, r);
   print_live_summary(o, r);
   return 0;
@@ -577,6 +635,10 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
       ->capture_default_str();
   run->add_option("--out", ro.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
   run->add_option("--record", ro.live.record, "Record the raw input to this file (candump -l format)");
+  run->add_flag("--resume", ro.resume,
+                "Go on from the newest valid power-loss snapshot in the snapshot folder (a new part when there is none)");
+  run->add_option("--snapshot-dir", ro.snapshot_dir,
+                  "Folder of the power-loss snapshots (profile [live] snapshot_s); default: the --out folder");
   run->add_flag("--quiet", ro.quiet, "No status lines");
   run->add_flag("--no-window", ro.no_window, "Do not open the viewer even when a display exists");
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
@@ -652,12 +714,14 @@ int run_tune_command(const TuneOptions& o) {
 struct ProfileOptions {
   std::string check_path;
   bool print_default = false;
+  bool can_bitrate = false;
 };
 
 CLI::App* add_profile_command(CLI::App& cli, ProfileOptions& po) {
   CLI::App* prof = cli.add_subcommand("profile", "Check a profile, or print the built-in default profile");
   prof->add_option("file", po.check_path, "Profile to check");
   prof->add_flag("--print-default", po.print_default, "Print the built-in default profile");
+  prof->add_flag("--can-bitrate", po.can_bitrate, "Print the profile's [live.can] bitrate [bit/s] only (lbrsim-can@.service)");
   return prof;
 }
 
@@ -671,6 +735,10 @@ int run_profile_command(const ProfileOptions& o) {
     return 2;
   }
   const app::Profile p = app::load_profile(o.check_path);
+  if (o.can_bitrate) {
+    std::printf("%d\n", p.live.can.bitrate);
+    return 0;
+  }
   std::printf("%s: ok (machine %s, %zu tools, level spacing %.4g mm)\n", o.check_path.c_str(), nc::to_string(p.kin.kind),
               p.tooling.tools.size(), p.solid.level_spacing_mm);
   return 0;
@@ -679,8 +747,9 @@ int run_profile_command(const ProfileOptions& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App cli{"lbrsim " LBRSIM_VERSION " — NC machining simulator on a level-based representation (LBR)"};
-  cli.set_version_flag("--version", std::string("lbrsim ") + LBRSIM_VERSION);
+  CLI::App cli{std::string("lbrsim ") + app::version() +
+               " — NC machining simulator on a level-based representation (LBR)"};
+  cli.set_version_flag("--version", std::string("lbrsim ") + app::version());
   cli.require_subcommand(1);
   std::string log_level = "info";
   cli.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/install_paths.hpp"
 #include "demo_program.inc"  // kDemoProgram
 #include "geom/serialize.hpp"
 #include "mesh/export.hpp"
@@ -43,7 +44,8 @@ bool is_gcode_path(const std::string& path) {
   return ext == ".ngc" || ext == ".nc" || ext == ".gcode" || ext == ".tap";
 }
 
-nc::Toolpath load_toolpath(const std::string& path, const Profile& profile, Interpreter interpreter) {
+nc::Toolpath load_toolpath(const std::string& path_as_given, const Profile& profile, Interpreter interpreter) {
+  const std::string path = find_program(path_as_given);
   const std::string ext = extension(path);
   if (ext == ".moves") {
     if (interpreter == Interpreter::Rs274)
@@ -65,8 +67,10 @@ std::vector<ChannelPath> load_channel_paths(const Profile& profile, Interpreter 
   std::vector<ChannelPath> channels;
   for (const Channel& c : profile.channels) {
     if (c.program.empty()) throw std::runtime_error(profile.source + ": channel '" + c.name + "' has no program");
-    const std::filesystem::path prog =
+    std::filesystem::path prog =
         std::filesystem::path(c.program).is_absolute() ? std::filesystem::path(c.program) : dir / c.program;
+    std::error_code ec;
+    if (!std::filesystem::exists(prog, ec)) prog = find_program(c.program);  // installed: programs apart from /etc
     Profile per = profile;
     per.machine.g54_origin_mm = c.g54_origin_mm;
     channels.push_back({c.name, load_toolpath(prog.string(), per, interpreter), c.kin});
@@ -78,6 +82,7 @@ nc::Toolpath demo_toolpath() { return nc::parse_movelist(kDemoProgram, "<built-i
 
 std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program) {
   nlohmann::json j;
+  j["lbrsim_version"] = version();
   j["program"] = program;
   j["profile"] = profile.source;
   j["stock_volume_mm3"] = r.stock_volume_mm3;

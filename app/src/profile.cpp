@@ -1,5 +1,7 @@
 #include "app/profile.hpp"
 
+#include "app/install_paths.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -136,7 +138,8 @@ Profile parse_profile(const std::string& text, const std::string& name) {
   return p;
 }
 
-Profile load_profile(const std::string& path) {
+Profile load_profile(const std::string& path_as_given) {
+  const std::string path = find_profile(path_as_given);  // then /etc/lbrsim (app/install_paths.hpp)
   std::ifstream f(path, std::ios::binary);
   if (!f) throw ProfileError(path + ":0: cannot open profile");
   std::ostringstream ss;

@@ -77,6 +77,7 @@ void RenderThread::loop() {
     PacingInfo pacing;
     pacing.rate_hz = cfg_.rate_hz;
     while (!stop_.load(std::memory_order_acquire)) {
+      frames_done_.store(frames_done_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
       const auto t0 = clock::now();
       if (prev != clock::time_point{}) {
         const double p = std::chrono::duration<double, std::milli>(t0 - prev).count();

@@ -15,6 +15,7 @@ void read_live_keys(cfg::Table& s, LiveConfig& c) {
   c.geometry_duty = s.number("geometry_duty", 0.7, 0.1, 1.0, "fraction");
   c.jump_tolerance = s.number("jump_tolerance", 1.5, 1.0, 100.0, "factor");
   c.merge_tolerance_mm = s.number("merge_tolerance_mm", 0.001, 0.0, 1.0, "mm");
+  c.snapshot_s = s.number("snapshot_s", 5.0, 0.0, 86400.0, "s");  // app/snapshot.hpp
 }
 
 void read_serial(cfg::Table& s, SerialConfig& c) { c.baud = static_cast<int>(s.integer("baud", 115200, 1200, 4000000)); }
@@ -25,6 +26,7 @@ void read_can(cfg::Table& s, CanConfig& c) {
   c.sync_counter_max = static_cast<int>(s.integer("sync_counter_max", 240, 2, 255));
   c.late_ms = s.number("late_ms", 0.0, 0.0, 1000.0, "ms");
   c.reconnect_ms = s.number("reconnect_ms", 500.0, 1.0, 60000.0, "ms");
+  c.bitrate = static_cast<int>(s.integer("bitrate", 500000, 10000, 1000000));  // lbrsim-can@.service
 }
 
 // Reads the sub-table [parent.key] with `read` and rejects its unknown keys.

@@ -20,12 +20,22 @@
 #include <vector>
 
 #include "app/profile.hpp"
+#include "app/snapshot.hpp"
 #include "geom/lbr_solid.hpp"
 #include "gfx/exchange.hpp"
 #include "nc/emulator.hpp"
 #include "nc/toolpath.hpp"
 
 namespace lbr::app {
+
+// Heartbeats of the pipeline's threads for the service watchdog (app/watchdog.hpp): each
+// thread bumps its counter once per loop pass, idle passes included, so a counter that stops
+// moving means a stalled thread. `*_running` is false before the thread starts and after it
+// ends. Written by the pipeline threads, read by any thread (relaxed).
+struct LiveProgress {
+  std::atomic<std::uint64_t> hal_loops{0}, geometry_loops{0};
+  std::atomic<bool> hal_running{false}, geometry_running{false};
+};
 
 struct LiveOptions {
   std::string source;     // can:IF | serial:DEV | replay:FILE | emulator:PROGRAM
@@ -48,6 +58,13 @@ struct LiveOptions {
   std::size_t overflow_capacity = 0;
   std::int64_t test_kernel_delay_ns = 0;
   double test_work_budget = 0;  // testing: work budget of one kernel call (0: the default)
+  // Power-loss snapshots (app/snapshot.hpp, docs/snapshot.md): written to `snapshot_dir`
+  // every profile.live.snapshot_s and when the run ends (none when empty or 0). `resume`:
+  // start from this snapshot (stock, channel poses; replay and emulator sources skip the
+  // samples it holds). Must outlive the pipeline.
+  std::string snapshot_dir;
+  const SnapshotState* resume = nullptr;
+  LiveProgress* progress = nullptr;  // heartbeats for the watchdog (may be null)
 };
 
 struct LiveResult {
@@ -78,6 +95,10 @@ struct LiveResult {
   std::uint64_t kernel_calls = 0, sweeps_split = 0, samples_unapplied = 0;
   double stop_latency_ms = 0;
   std::vector<std::string> warnings{};  // as given to LiveOptions::on_warning
+  // Snapshots written (periodic and final) and failed; resumed: the snapshot's generation
+  // and the source position it skipped to (0: not resumed).
+  std::uint64_t snapshots_written = 0, snapshots_failed = 0, resumed_generation = 0, resumed_position = 0;
+  double snapshot_copy_max_ms = 0;  // longest copy of the solid into the writer's slot (geometry thread)
 };
 
 using StatusFn = std::function<void(const std::string& line)>;

@@ -194,6 +194,7 @@ std::size_t Geometry::tick(std::size_t limit) {
     hal::AxisSample* s = ring_.front();
     if (s == nullptr) break;
     stream_.take(s->channel, s->seq, s->tool, s->q, s->mask);
+    if (s->channel < hal::kMaxChannels) pending_[s->channel] = *s, pending_have_[s->channel] = true;
     rx_[n] = s->t_rx_ns;
     weight_[n++] = 1 + s->coalesced;
     ring_.pop();
@@ -211,6 +212,8 @@ std::size_t Geometry::tick(std::size_t limit) {
       return n;
     }
     last_rx_ns_ = rx_[n - 1];
+    last_ = pending_;
+    have_ = pending_have_;
     const std::int64_t t = sched::now_ns();
     for (std::size_t i = 0; i < n; ++i)
       for (std::uint32_t w = 0; w < weight_[i]; ++w) lag_.record(t - rx_[i]);
@@ -249,6 +252,19 @@ bool Geometry::publish(const gfx::LiveStats& stats) {
     tools[n++] = gfx::tool_state(c.tool.shape->tool, 1, c.pose, i);
   }
   return ex_->publish(solid_, std::span<const gfx::ToolState>(tools.data(), n), stream_.last_id(), stats);
+}
+
+void Geometry::prime(const std::array<bool, hal::kMaxChannels>& have,
+                     const std::array<hal::AxisSample, hal::kMaxChannels>& last) noexcept {
+  for (int c = 0; c < hal::kMaxChannels; ++c) {
+    if (!have[c]) continue;
+    const hal::AxisSample& s = last[c];
+    stream_.take(c, s.seq, s.tool, s.q, s.mask);  // a channel's first sample: a pose, no sweep
+  }
+  stream_.flush_all();
+  stream_.clear_batch();
+  have_ = pending_have_ = have;
+  last_ = pending_ = last;
 }
 
 void Geometry::publish_volume() noexcept {

@@ -75,6 +75,13 @@ class Geometry final : public motion::SweepSink {
   bool publish(const gfx::LiveStats& stats);
   [[nodiscard]] std::int64_t last_rx_ns() const noexcept { return last_rx_ns_; }
 
+  // Power-loss resume (app/snapshot.hpp): each channel's newest applied sample, and priming
+  // the motion stream with them so the next sample sweeps from where the tool was. prime()
+  // is setup (before the thread starts); last_applied() is read on the geometry thread.
+  void prime(const std::array<bool, hal::kMaxChannels>& have, const std::array<hal::AxisSample, hal::kMaxChannels>& last) noexcept;
+  [[nodiscard]] const std::array<bool, hal::kMaxChannels>& have_applied() const noexcept { return have_; }
+  [[nodiscard]] const std::array<hal::AxisSample, hal::kMaxChannels>& last_applied() const noexcept { return last_; }
+
   void publish_volume() noexcept;
   [[nodiscard]] std::uint64_t applied() const noexcept { return applied_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t sweeps() const noexcept { return sweeps_.load(std::memory_order_relaxed); }
@@ -127,6 +134,8 @@ class Geometry final : public motion::SweepSink {
   int ticks_since_volume_ = 0;
   gfx::SolidExchange* ex_ = nullptr;
   std::int64_t last_rx_ns_ = 0;
+  std::array<bool, hal::kMaxChannels> have_{}, pending_have_{};
+  std::array<hal::AxisSample, hal::kMaxChannels> last_{}, pending_{};
 };
 
 }  // namespace lbr::app::live

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cinttypes>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -40,7 +41,17 @@ struct LivePipeline::Impl {
   std::FILE* rec_file = nullptr;
   std::string rec_iface = "can0";
   std::unique_ptr<RingSink> sink;
+  std::unique_ptr<live::SkipSink> skip_sink;  // resumed replay: drops what the solid holds
+  hal::SampleSink* input = nullptr;            // what the source delivers to
   std::unique_ptr<Geometry> geo;
+  // Power-loss snapshots (app/snapshot.hpp): the writer, its period, and where a resumed
+  // run started (the source's sample numbers restart at 1 after an emulator skip).
+  std::unique_ptr<SnapshotWriter> snap;
+  std::int64_t snapshot_period_ns = 0;
+  std::uint64_t seq_base = 0, applied_base = 0;
+  double wall_base_s = 0;
+  std::atomic<std::uint64_t> rec_bytes{0};  // written to the --record file so far
+  std::atomic<std::int64_t> snapshot_copy_max_ns{0};  // longest copy of the solid on the geometry thread
 
   // start() .. stop()
   std::atomic<bool> stop_requested{false};
@@ -54,13 +65,15 @@ struct LivePipeline::Impl {
   std::int64_t t0 = 0;
   std::thread hal, geometry, recorder;
   bool stopped = false;
+  LiveProgress own_progress;  // when the caller gives none
+  LiveProgress* progress = &own_progress;
 
   Impl(const Profile& p, LiveOptions o, const std::atomic<bool>& stop) : profile(p), opt(std::move(o)), external_stop(stop) {}
 };
 
 namespace {
 
-void write_record_line(std::FILE* f, const hal::RawRecord& r, const std::string& iface) {
+std::size_t write_record_line(std::FILE* f, const hal::RawRecord& r, const std::string& iface) {
   char line[256];
   if (r.serial) {
     const long long sec = r.t_wall_ns / 1'000'000'000, usec = (r.t_wall_ns % 1'000'000'000) / 1000;
@@ -69,12 +82,13 @@ void write_record_line(std::FILE* f, const hal::RawRecord& r, const std::string&
       n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), "%02X", r.bytes[i]);
     std::fputs(line, f);
     std::fputc('\n', f);
-  } else {
-    hal::CanFrame fr = r.frame;
-    fr.t_ns = r.t_wall_ns;
-    const std::size_t n = hal::format_candump_line(fr, iface, line);
-    std::fwrite(line, 1, n, f);
+    return static_cast<std::size_t>(n) + 1;
   }
+  hal::CanFrame fr = r.frame;
+  fr.t_ns = r.t_wall_ns;
+  const std::size_t n = hal::format_candump_line(fr, iface, line);
+  std::fwrite(line, 1, n, f);
+  return n;
 }
 
 // Counters for the HUD, read on the geometry thread when it publishes (reads of counters
@@ -114,19 +128,56 @@ gfx::LiveStats live_stats(const LivePipeline::Impl& p) {
 // samples_unapplied) — checked between kernel calls, whose work the budget bounds.
 constexpr std::int64_t kStopGraceNs = 250'000'000;
 
+void bump(std::atomic<std::uint64_t>& c) noexcept { c.store(c.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
+
+// What a snapshot records besides the solid (the geometry thread's state at a batch boundary).
+void fill_snapshot(const LivePipeline::Impl& p, SnapshotState& s) {
+  s.source = p.opt.source;
+  s.have = p.geo->have_applied();
+  s.last = p.geo->last_applied();
+  s.source_position = p.seq_base;
+  for (int c = 0; c < hal::kMaxChannels; ++c) {
+    if (!s.have[c]) continue;
+    s.last[c].seq += p.seq_base;  // the source's numbering from its start
+    s.source_position = std::max(s.source_position, s.last[c].seq);
+  }
+  s.samples_applied = p.applied_base + p.geo->applied();
+  s.record_offset = p.rec_bytes.load(std::memory_order_relaxed);
+  s.wall_time_s = p.wall_base_s + static_cast<double>(sched::now_ns() - p.t0) * 1e-9;
+}
+
+// Periodic snapshot at a batch boundary: the solid is copied into the writer's free slot
+// (no I/O, no waiting; a busy writer means trying again after the next batch).
+void offer_snapshot(LivePipeline::Impl& p, std::int64_t& due_ns) {
+  if (!p.snap || sched::now_ns() < due_ns) return;
+  SnapshotState* s = p.snap->slot();
+  if (s == nullptr) return;
+  const std::int64_t t0 = sched::now_ns();
+  s->solid = p.r->solid;
+  fill_snapshot(p, *s);
+  p.snap->commit();
+  const std::int64_t took = sched::now_ns() - t0;
+  if (took > p.snapshot_copy_max_ns.load(std::memory_order_relaxed)) p.snapshot_copy_max_ns.store(took, std::memory_order_relaxed);
+  due_ns = sched::now_ns() + p.snapshot_period_ns;
+}
+
 void geometry_thread(LivePipeline::Impl& p) {
   const hal::LiveConfig& cfg = p.profile.live;
   p.geo_mode = sched::configure_current_thread(cfg.geometry_thread) == sched::RtMode::Fifo ? 1 : 0;
   const std::size_t chunk = p.backpressure ? static_cast<std::size_t>(p.profile.batch_moves) : p.ring->capacity();
   const std::int64_t idle_ns = static_cast<std::int64_t>(cfg.geometry_idle_us) * 1000;
   const double rest_per_work = p.backpressure ? 0.0 : 1.0 / cfg.geometry_duty - 1.0;
+  std::int64_t snapshot_due_ns = sched::now_ns() + p.snapshot_period_ns;
+  p.progress->geometry_running.store(true, std::memory_order_relaxed);
   for (;;) {
+    bump(p.progress->geometry_loops);
     const bool finished = p.hal_done.load(std::memory_order_acquire);
     const std::int64_t t_tick = sched::now_ns();
     if (p.geo->stop_due()) break;
     if ((finished || !p.backpressure || p.ring->size() >= chunk) && p.geo->tick(chunk) > 0) {
       if (p.geo->abandoned()) break;
       if (p.opt.exchange != nullptr) (void)p.geo->publish(live_stats(p));
+      offer_snapshot(p, snapshot_due_ns);
       if (rest_per_work > 0.0 && !finished) {
         const std::int64_t now = sched::now_ns();
         sched::sleep_until_ns(now + static_cast<std::int64_t>(static_cast<double>(now - t_tick) * rest_per_work));
@@ -144,6 +195,7 @@ void geometry_thread(LivePipeline::Impl& p) {
     sched::sleep_until_ns(sched::now_ns() + 2'000'000);
   p.geo_end_ns.store(sched::now_ns(), std::memory_order_relaxed);
   p.geo->publish_volume();
+  p.progress->geometry_running.store(false, std::memory_order_relaxed);
   p.geo_running.store(false, std::memory_order_release);
 }
 
@@ -156,19 +208,25 @@ bool stop_asked(const LivePipeline::Impl& p) noexcept {
 // ends, it waits for the held ones to go in, unless a stop is asked for.
 void hal_thread(LivePipeline::Impl& p) {
   p.hal_mode = sched::configure_current_thread(p.profile.live.hal_thread) == sched::RtMode::Fifo ? 1 : 0;
+  p.progress->hal_running.store(true, std::memory_order_relaxed);
   while (!stop_asked(p)) {
-    const hal::PollResult pr = p.src->poll(50, *p.sink);
+    bump(p.progress->hal_loops);
+    const hal::PollResult pr = p.src->poll(50, *p.input);
     p.source_lost.store(p.src->lost(), std::memory_order_relaxed);  // the source is this thread's
     (void)p.sink->pump();
     if (pr == hal::PollResult::End) break;
     if (pr == hal::PollResult::Error) sched::sleep_until_ns(sched::now_ns() + 1'000'000);  // no busy loop
   }
-  while (!p.sink->pump() && !stop_asked(p)) sched::sleep_until_ns(sched::now_ns() + 1'000'000);
+  while (!p.sink->pump() && !stop_asked(p)) {
+    bump(p.progress->hal_loops);
+    sched::sleep_until_ns(sched::now_ns() + 1'000'000);
+  }
   if (stop_asked(p)) {
     std::int64_t expected = 0;
     (void)p.stop_ns.compare_exchange_strong(expected, sched::now_ns(), std::memory_order_relaxed);
   }
   p.hal_abandoned.store(p.sink->abandon(), std::memory_order_relaxed);
+  p.progress->hal_running.store(false, std::memory_order_relaxed);
   p.hal_done.store(true, std::memory_order_release);
 }
 
@@ -179,7 +237,8 @@ void recorder_thread(LivePipeline::Impl& p) {
     const bool finished = p.hal_done.load(std::memory_order_acquire);
     bool any = false;
     while (hal::RawRecord* rec = p.rec_ring->front()) {
-      write_record_line(p.rec_file, *rec, p.rec_iface);
+      const std::size_t n = write_record_line(p.rec_file, *rec, p.rec_iface);
+      p.rec_bytes.store(p.rec_bytes.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
       p.rec_ring->pop();
       any = true;
     }
@@ -215,6 +274,36 @@ void snapshot(LivePipeline::Impl& p) {
   r.removed_volume_mm3 = p.geo->removed_mm3();
 }
 
+// Resuming: the snapshot's solid, counters and channel poses; the emulator and replay
+// sources skip the samples it holds (live sources go on with what the machine sends now).
+void resume_from(LivePipeline::Impl& p, const SnapshotState& snap) {
+  geom::LbrSolid& solid = p.r->solid;
+  if (snap.solid.levels() != solid.levels() || snap.solid.regions() != solid.regions())
+    throw std::runtime_error(p.profile.source + ": the snapshot's stock (" + std::to_string(snap.solid.levels()) +
+                             " levels x " + std::to_string(snap.solid.regions()) + " regions) is not the profile's (" +
+                             std::to_string(solid.levels()) + " x " + std::to_string(solid.regions()) +
+                             "); start without --resume for a new part");
+  solid = snap.solid;
+  p.applied_base = snap.samples_applied;
+  p.wall_base_s = snap.wall_time_s;
+  p.r->resumed_generation = snap.generation;
+  p.r->resumed_position = snap.source_position;
+}
+
+void start_snapshots(LivePipeline::Impl& p) {
+  const std::string& dir = p.opt.snapshot_dir;
+  if (dir.empty() || p.profile.live.snapshot_s <= 0.0) return;
+  std::uint64_t generation = 1;
+  if (p.opt.resume != nullptr) {
+    generation = p.opt.resume->generation + 1;
+  } else {  // a new part: a later --resume must not find the previous part's snapshots
+    std::error_code ec;
+    for (const char* f : {"snapshot-a.lbrsnap", "snapshot-b.lbrsnap"}) std::filesystem::remove(std::filesystem::path(dir) / f, ec);
+  }
+  p.snap = std::make_unique<SnapshotWriter>(dir, generation);
+  p.snapshot_period_ns = static_cast<std::int64_t>(p.profile.live.snapshot_s * 1e9);
+}
+
 geom::SolidSpec live_solid_spec(const Profile& profile, const motion::ToolTable& tools) {
   geom::SolidSpec spec = profile.solid;
   if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tools.max_diameter());
@@ -241,21 +330,43 @@ void LivePipeline::configure() {
   p.r.emplace(LiveResult{geom::LbrSolid(live_solid_spec(profile, *p.tools)), p.opt.source, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
                          {}, 0, 0, 0, 0, 0, 0, ""});
   p.r->stock_volume_mm3 = p.r->solid.initial_volume_mm3();
+  if (p.opt.progress != nullptr) p.progress = p.opt.progress;
+  const SnapshotState* resume = p.opt.resume;
+  if (resume != nullptr) resume_from(p, *resume);
+  const bool emulator = p.opt.source.rfind("emulator:", 0) == 0, replay = p.opt.source.rfind("replay:", 0) == 0;
+  p.seq_base = resume != nullptr && emulator ? resume->source_position : 0;
+  start_snapshots(p);
 
-  p.src = live::make_source(profile, p.opt.source, p.opt.speed);
+  p.src = live::make_source(profile, p.opt.source, p.opt.speed, p.seq_base);
   p.src->open();
   p.backpressure = !p.src->live();
   p.ring = std::make_unique<sched::SpscRing<hal::AxisSample>>(cfg.ring_capacity);
   if (!p.opt.record.empty()) {
-    p.rec_file = std::fopen(p.opt.record.c_str(), "w");
+    // Resumed: the recording goes on in the same file, so snapshot offsets stay file offsets.
+    p.rec_file = std::fopen(p.opt.record.c_str(), resume != nullptr ? "a" : "w");
     if (p.rec_file == nullptr) throw std::runtime_error(p.opt.record + ": cannot open for writing");
+    if (resume != nullptr) {
+      std::error_code ec;
+      const auto size = std::filesystem::file_size(p.opt.record, ec);
+      p.rec_bytes.store(ec ? 0 : static_cast<std::uint64_t>(size), std::memory_order_relaxed);
+    }
     p.rec_ring = std::make_unique<sched::SpscRing<hal::RawRecord>>(1 << 15);
     p.src->set_recording(true);
   }
   if (p.opt.source.rfind("can:", 0) == 0) p.rec_iface = p.opt.source.substr(4);
   p.sink = std::make_unique<RingSink>(*p.ring, p.rec_ring.get(), cfg, p.backpressure, p.stop_requested,
                                       p.opt.overflow_capacity);
+  p.input = p.sink.get();
+  if (resume != nullptr && replay) {
+    p.skip_sink = std::make_unique<live::SkipSink>(*p.sink, resume->source_position);
+    p.input = p.skip_sink.get();
+  }
   p.geo = std::make_unique<Geometry>(p.r->solid, profile, *p.tools, cfg.tool, *p.ring, cfg.merge_tolerance_mm);
+  if (resume != nullptr && (emulator || replay)) {  // a live machine has moved on: no sweep across the outage
+    std::array<hal::AxisSample, hal::kMaxChannels> last = resume->last;
+    for (hal::AxisSample& s : last) s.seq = s.seq >= p.seq_base ? s.seq - p.seq_base : 0;
+    p.geo->prime(resume->have, last);
+  }
   p.geo->set_stop(&p.external_stop, &p.stop_requested, &p.stop_ns, kStopGraceNs);
   p.geo->set_kernel_delay_ns(p.opt.test_kernel_delay_ns);
   if (p.opt.test_work_budget > 0) p.geo->set_work_budget(p.opt.test_work_budget);
@@ -338,6 +449,19 @@ LiveResult LivePipeline::result() {
   }
   const bool fifo = p.hal_mode.load() == 1 && p.geo_mode.load() == 1;
   r.rt_mode = fifo ? "fifo" : "non-rt";
+  if (p.snap) {  // clean shutdown: the final state, after any periodic one still being written
+    SnapshotState s;
+    s.solid = r.solid;
+    fill_snapshot(p, s);
+    try {
+      p.snap->write_now(s);
+    } catch (const std::exception& e) {
+      r.warnings.push_back(std::string("final snapshot not written: ") + e.what());
+    }
+    r.snapshots_written = p.snap->written();
+    r.snapshot_copy_max_ms = static_cast<double>(p.snapshot_copy_max_ns.load()) * 1e-6;
+    r.snapshots_failed = p.snap->failed();
+  }
   return std::move(r);
 }
 

@@ -3,7 +3,9 @@
 // program, or a device that cannot be found.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "app/profile.hpp"
@@ -11,6 +13,26 @@
 
 namespace lbr::app::live {
 
-[[nodiscard]] std::unique_ptr<hal::Source> make_source(const Profile& profile, const std::string& spec, double speed);
+// `skip`: resuming (app/snapshot.hpp), the emulator starts after its first `skip` samples
+// (they are computed, not paced); other sources ignore it (replay skips with SkipSink).
+[[nodiscard]] std::unique_ptr<hal::Source> make_source(const Profile& profile, const std::string& spec, double speed,
+                                                      std::uint64_t skip = 0);
+
+// Resuming a replay: drops the samples whose sequence number is at most `through` (they
+// are in the resumed solid) and forwards the rest. HAL thread; real-time safe.
+class SkipSink final : public hal::SampleSink {
+ public:
+  SkipSink(hal::SampleSink& next, std::uint64_t through) : next_(next), through_(through) {}
+  void on_samples(std::span<const hal::AxisSample> samples) noexcept override {
+    std::size_t i = 0;
+    while (i < samples.size() && samples[i].seq <= through_) ++i;
+    if (i < samples.size()) next_.on_samples(samples.subspan(i));
+  }
+  void on_raw(const hal::RawRecord& r) noexcept override { next_.on_raw(r); }
+
+ private:
+  hal::SampleSink& next_;
+  std::uint64_t through_;
+};
 
 }  // namespace lbr::app::live

@@ -71,6 +71,9 @@ class RenderThread {
   // Request fit-to-part at the next frame (uses the stock box).
   void request_fit();
 
+  // Frame loop passes so far (any thread): the service watchdog's heartbeat (app/watchdog.hpp).
+  [[nodiscard]] std::uint64_t frames_done() const noexcept { return frames_done_.load(std::memory_order_relaxed); }
+
   // Available after stop().
   [[nodiscard]] const PacingReport& report() const noexcept { return report_; }
 
@@ -83,6 +86,7 @@ class RenderThread {
   RenderThreadConfig cfg_;
   std::thread thread_;
   std::atomic<bool> running_{false}, stop_{false};
+  std::atomic<std::uint64_t> frames_done_{0};
   std::mutex mu_;  // guards the fields below (main ↔ render thread, never the geometry thread)
   Camera cam_;
   RenderOptions opt_;

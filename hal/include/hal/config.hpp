@@ -28,6 +28,7 @@ struct CanConfig {
   int sync_counter_max = 240;      // SYNC counter runs 1..max, then 1 again
   double late_ms = 0.0;            // TPDO later than this after SYNC is late; 0 = 0.8 × period
   double reconnect_ms = 500.0;     // retry period after bus-off / interface down
+  int bitrate = 500000;            // [bit/s] for setting up the interface (lbrsim-can@.service, docs/deployment.md)
 };
 
 struct SerialConfig {
@@ -40,6 +41,7 @@ struct LiveConfig {
   double jump_tolerance = 1.5;     // allowed step = max_speed × Δt × tolerance + 2 counts
   int tool = 1;                    // tool in the spindle (samples carry no tool number)
   double merge_tolerance_mm = 0.001;  // samples within this of a straight sweep extend it
+  double snapshot_s = 5.0;         // power-loss snapshot period [s]; 0: none (docs/snapshot.md)
   std::size_t ring_capacity = 4096;
   int geometry_idle_us = 1000;     // geometry thread looks at an empty ring again after this [µs]
   double geometry_duty = 0.7;      // most of the time the geometry thread may work (see live.cpp)

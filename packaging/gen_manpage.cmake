@@ -1,0 +1,32 @@
+# Writes a man page (roff) for PROG from its --help and, for lbrsim, every subcommand's
+# --help. Arguments: -DPROG=binary -DNAME=name -DVERSION=x.y.z -DOUT=file.1
+function(help_of args out)
+  execute_process(COMMAND ${PROG} ${args} --help OUTPUT_VARIABLE text RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${PROG} ${args} --help failed (${rc})")
+  endif()
+  string(REPLACE "\\" "\\e" text "${text}")
+  string(REGEX REPLACE "\n\\." "\n\\\\&." text "${text}")
+  string(REGEX REPLACE "\n'" "\n\\\\&'" text "${text}")
+  string(REGEX REPLACE "Usage: [^ \n]*/" "Usage: " text "${text}")
+  string(REPLACE "-" "\\-" text "${text}")
+  set(${out} "${text}" PARENT_SCOPE)
+endfunction()
+
+help_of("" main)
+string(REGEX MATCH "^[^\n]*" first "${main}")
+string(REGEX REPLACE "^[^ ]+ [^ ]+ — " "" summary "${first}")
+string(REGEX REPLACE "^[^ ]+ \\\\- " "" summary "${summary}")
+set(page ".TH ${NAME} 1 \"\" \"${NAME} ${VERSION}\" \"User Commands\"\n.SH NAME\n${NAME} \\- ${summary}\n")
+string(APPEND page ".SH SYNOPSIS\n.nf\n${main}.fi\n")
+if(NAME STREQUAL "lbrsim")
+  foreach(sub batch view run emulate tune profile)
+    help_of("${sub}" h)
+    string(APPEND page ".SH COMMAND ${sub}\n.nf\n${h}.fi\n")
+  endforeach()
+  string(APPEND page ".SH FILES\n.TP\n/etc/lbrsim/*.toml\nmachine profiles (\\-\\-profile NAME finds NAME.toml here)\n"
+                     ".TP\n/usr/share/lbrsim/programs\nbundled part programs\n"
+                     ".TP\n/var/lib/lbrsim/PROFILE\nresults and power\\-loss snapshots of lbrsim@PROFILE.service\n")
+endif()
+string(APPEND page ".SH SEE ALSO\n/usr/share/doc/lbrsim/README.md, /usr/share/doc/lbrsim/deployment.md\n")
+file(WRITE ${OUT} "${page}")
