@@ -22,7 +22,7 @@ app::SnapshotState cut_state(std::uint64_t generation, double depth_mm) {
   const app::Profile p = app::default_profile();
   app::SnapshotState s;
   s.solid = geom::LbrSolid(p.solid);
-  const geom::Tool& t = p.tools.begin()->second;
+  const geom::Tool& t = p.tooling.tools.begin()->second;
   const geom::CutterShape shape = geom::CutterShape::build(t, p.solid.chord_tol_mm);
   geom::SweepRef sw;
   sw.shape = &shape;
