@@ -192,7 +192,10 @@ TEST(Rs274Canon, RecordedOutputMatchesTheBuiltInInterpreter) {
 TEST(Rs274Canon, UnrepresentableCommandsAreErrors) {
   EXPECT_EQ(error_of_canon("    1 N3     STRAIGHT_PROBE(0.0000, 0.0000, -5.0000, 0.0000, 0.0000, 0.0000, 0)\n"),
             "p.ngc:3: rs274: canonical command STRAIGHT_PROBE is not supported");
-  EXPECT_EQ(error_of_canon("    1 N4     SET_FEED_MODE(0, 1)\n"), "p.ngc:4: rs274: feed per revolution (G95) is not supported");
+  EXPECT_EQ(error_of_canon("    1 N4     SET_FEED_MODE(0, 1)\n    2 N4     SET_FEED_RATE(0.1000)\n"
+                           "    3 N4     STRAIGHT_FEED(1.0000, 0.0000, 0.0000, 0.0000, 0.0000, 0.0000)\n"),
+            "p.ngc:4: rs274: STRAIGHT_FEED per revolution or synchronised with the spindle needs a spindle speed S > 0 "
+            "(at X0 in G96: D)");
   EXPECT_EQ(error_of_canon("    1 N5     SET_XY_ROTATION(30.0000)\n"), "p.ngc:5: rs274: XY rotation (G10 L2 R) is not supported");
   EXPECT_EQ(error_of_canon("    1 N6     STRAIGHT_FEED(1.0000, 0.0000)\n"),
             "p.ngc:6: rs274: canonical command STRAIGHT_FEED has 2 numbers, expected 6");

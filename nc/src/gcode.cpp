@@ -234,7 +234,7 @@ class Interpreter {
       case 'M': blk.m.push_back(w); break;
       case 'N': break;  // line number: no meaning to the motion
       case 'X': case 'Y': case 'Z': case 'A': case 'B': case 'C': case 'I': case 'J': case 'K':
-      case 'R': case 'P': case 'Q': case 'L': case 'H': case 'F': case 'S': case 'T': case 'D': {
+      case 'R': case 'P': case 'Q': case 'L': case 'H': case 'F': case 'S': case 'T': case 'D': case 'E': {
         const int k = idx(L);
         if (blk.has[k]) fail("word '" + std::string(1, L) + "' given twice ('" + blk.text[k] + "', '" + w.text + "')");
         blk.has[k] = true;
@@ -327,14 +327,15 @@ class Interpreter {
     const int c = code10(w);
     if (std::abs(w.value * 10.0 - c) > 1e-6) return -1;
     switch (c) {
-      case 0: case 10: case 20: case 30: case 800: case 810: case 820: case 830: case 730: return kMotion;
+      case 0: case 10: case 20: case 30: case 330: case 331: case 760: case 800: case 810: case 820: case 830: case 730:
+        return kMotion;
       case 170: case 180: case 190: return kPlane;
       case 900: case 910: return kDistance;
       case 901: case 911: return kArcDistance;
       case 930: case 940: case 950: return kFeedMode;
       case 960: case 970: return kSpindleMode;
       case 200: case 210: return kUnits;
-      case 400: return kCutter;
+      case 400: case 410: case 411: case 420: case 421: return kCutter;
       case 430: case 490: return kLength;
       case 980: case 990: return kRetract;
       case 540: case 550: case 560: case 570: case 580: case 590: case 591: case 592: case 593: return kCoord;
@@ -349,20 +350,56 @@ class Interpreter {
   std::string unsupported_g(const Word& w) const {
     const int c = code10(w);
     const char* why = "not supported by the built-in interpreter";
-    if (c == 410 || c == 420 || c == 411 || c == 421) why = "cutter radius compensation";
-    if (c == 330 || c == 331 || c == 760)
-      return "unsupported word '" + w.text + "' (spindle-synchronised motion: the tool path carries no spindle angle)";
-    else if (c == 381 || c == 382 || c == 383 || c == 384) why = "probing";
+    if (c == 700 || c == 710 || c == 720)
+      return "unsupported word '" + w.text + "' (lathe finishing/roughing cycles G70-G72 are not in the built-in interpreter" +
+             kUseRs274 + ")";
+    if (c == 381 || c == 382 || c == 383 || c == 384) why = "probing";
     else if (c == 431) why = "dynamic tool length offset";
-    else if (c == 840 || c == 850 || c == 860 || c == 870 || c == 880 ||
-             c == 890)
-      why = "this cycle";
+    else if (c == 840 || c == 850 || c == 860 || c == 870 || c == 880 || c == 890) why = "this cycle";
     return "unsupported word '" + w.text + "' (" + why + kUseRs274 + ")";
   }
 
+  // The G- and M-codes of one block, sorted into their modal groups.
+  struct Codes {
+    std::array<const Word*, kGroups> g{};
+    int dwell = 0, g10 = 0, home = 0, g53 = 0, g92 = 0;  // non-modal codes x 10 (home: 280, 281, 300, 301)
+    const Word* mstop = nullptr;
+    const Word* mspindle = nullptr;
+    const Word* m6 = nullptr;
+    const Word* mcool = nullptr;
+    const Word* m61 = nullptr;
+    const Word* mio = nullptr;  // overrides, digital outputs: nothing to simulate
+    bool f_in_block = false;
+  };
+
   void execute(Block& b) {
-    // Modal groups: one G-code per group and block.
-    std::array<const Word*, kGroups> gw{};
+    Codes k = group_codes(b);
+    set_feed_and_speed(b, k);
+    change_tools(b, k);
+    if (k.mspindle != nullptr) spindle_ = static_cast<int>(k.mspindle->value);
+    if (k.mcool != nullptr) coolant_ = static_cast<int>(k.mcool->value);
+    if (k.dwell != 0) {
+      if (!has(b, 'P')) fail("'G4' needs P (dwell time [s])");
+      const double p = raw(b, 'P');
+      if (p < 0) fail("'" + text(b, 'P') + "': dwell time must be >= 0");
+      b_.dwell(line_, p);
+    }
+    set_modes(b, k);
+    // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing).
+    for (int a = 0; a < kAxes; ++a)
+      if (has(b, kAxisLetters[a]) && !axis_allowed(a) && k.g10 == 0)
+        fail("word '" + text(b, kAxisLetters[a]) + "' needs an axis the machine lacks (machine kind " + machine_name() + ")");
+    move(b, k);
+    check_all_words_used(b);
+    if (k.mstop != nullptr) {
+      const int c = static_cast<int>(k.mstop->value);
+      if (c == 2 || c == 30) ended_ = true;
+      else ++pauses_;  // M0/M1: program pause; no motion
+    }
+  }
+
+  Codes group_codes(const Block& b) const {
+    Codes k;
     std::vector<const Word*> nonmodal;
     for (const Word& w : b.g) {
       const int gr = group_of(w);
@@ -371,197 +408,302 @@ class Interpreter {
         nonmodal.push_back(&w);
         continue;
       }
-      if (gw[gr] != nullptr) fail("'" + gw[gr]->text + "' and '" + w.text + "' are in the same modal group");
-      gw[gr] = &w;
+      if (k.g[gr] != nullptr) fail("'" + k.g[gr]->text + "' and '" + w.text + "' are in the same modal group");
+      k.g[gr] = &w;
     }
-    int dwell = 0, g10 = 0, home = 0, g53 = 0, g92 = 0;  // home: 280, 281, 300, 301
     for (const Word* w : nonmodal) {
       const int c = code10(*w);
-      int* slot = c == 40 ? &dwell : c == 100 ? &g10 : c == 530 ? &g53 : c >= 920 ? &g92 : &home;
-      if (*slot != 0 || (slot == &g10 && (home != 0 || g92 != 0)) || (slot == &home && (g10 != 0 || g92 != 0)) ||
-          (slot == &g92 && (g10 != 0 || home != 0)))
+      int* slot = c == 40 ? &k.dwell : c == 100 ? &k.g10 : c == 530 ? &k.g53 : c >= 920 ? &k.g92 : &k.home;
+      if (*slot != 0 || (slot == &k.g10 && (k.home != 0 || k.g92 != 0)) ||
+          (slot == &k.home && (k.g10 != 0 || k.g92 != 0)) || (slot == &k.g92 && (k.g10 != 0 || k.home != 0)))
         fail("'" + w->text + "' cannot be combined with another non-modal G-code in the block");
       *slot = c;
     }
-    const Word* mstop = nullptr;
-    const Word* mspindle = nullptr;
-    const Word* m6 = nullptr;
-    const Word* mcool = nullptr;
-    const Word* m61 = nullptr;
-    const Word* mio = nullptr;  // overrides, digital outputs: nothing to simulate
     for (const Word& w : b.m) {
       const int c = static_cast<int>(std::lround(w.value));
       if (w.value != std::floor(w.value)) fail("unsupported word '" + w.text + "'");
-      const Word** slot = nullptr;
-      switch (c) {
-        case 0: case 1: case 2: case 30: slot = &mstop; break;
-        case 3: case 4: case 5: slot = &mspindle; break;
-        case 6: slot = &m6; break;
-        case 7: case 8: case 9: slot = &mcool; break;
-        case 61: slot = &m61; break;
-        case 48: case 49: case 50: case 51: case 52: case 53: case 62: case 63: case 64: case 65: slot = &mio; break;
-        default:
-          if (c >= 100 && c <= 199)
-            fail("unsupported word '" + w.text + "' (user-defined M-code: runs a program on the controller)");
-          if (c >= 200) fail("unsupported word '" + w.text + "' (machine-specific M-code or remap)");
-          fail("unsupported word '" + w.text + "' (not supported by the built-in interpreter" + std::string(kUseRs274) +
-               ")");
-      }
+      const Word** slot = m_slot(k, w, c);
       if (*slot != nullptr && !(c == 7 || c == 8))
         fail("'" + (*slot)->text + "' and '" + w.text + "' are in the same modal group");
       *slot = &w;
     }
+    return k;
+  }
 
-    // 1. feed mode, F
-    if (gw[kFeedMode]) {
-      inverse_time_ = code10(*gw[kFeedMode]) == 930;
-      per_rev_ = code10(*gw[kFeedMode]) == 950;
+  const Word** m_slot(Codes& k, const Word& w, int c) const {
+    switch (c) {
+      case 0: case 1: case 2: case 30: return &k.mstop;
+      case 3: case 4: case 5: return &k.mspindle;
+      case 6: return &k.m6;
+      case 7: case 8: case 9: return &k.mcool;
+      case 61: return &k.m61;
+      case 48: case 49: case 50: case 51: case 52: case 53: case 62: case 63: case 64: case 65: return &k.mio;
+      default: break;
     }
-    bool f_in_block = false;
+    if (c >= 100 && c <= 199) fail("unsupported word '" + w.text + "' (user-defined M-code: runs a program on the controller)");
+    if (c >= 200) fail("unsupported word '" + w.text + "' (machine-specific M-code or remap)");
+    fail("unsupported word '" + w.text + "' (not supported by the built-in interpreter" + std::string(kUseRs274) + ")");
+  }
+
+  // 1. feed mode, F; 2. S with the spindle speed mode: G97 S [rpm], G96 S [m/min | ft/min] D [max rpm]
+  void set_feed_and_speed(Block& b, Codes& k) {
+    if (k.g[kFeedMode]) {
+      inverse_time_ = code10(*k.g[kFeedMode]) == 930;
+      per_rev_ = code10(*k.g[kFeedMode]) == 950;
+    }
     if (has(b, 'F')) {
       feed_ = raw(b, 'F');
       if (feed_ < 0) fail("'" + text(b, 'F') + "': feed rate must be >= 0");
-      f_in_block = true;
+      k.f_in_block = true;
     }
-    // 2. S, with the spindle speed mode: G97 S [rpm], G96 S [m/min | ft/min] D [max rpm]
     if (has(b, 'S')) {
       spindle_rpm_ = raw(b, 'S');
       if (spindle_rpm_ < 0) fail("'" + text(b, 'S') + "': spindle speed must be >= 0");
     }
-    if (gw[kSpindleMode]) {
-      css_ = code10(*gw[kSpindleMode]) == 960;
+    if (k.g[kSpindleMode]) {
+      css_ = code10(*k.g[kSpindleMode]) == 960;
       if (css_ && has(b, 'D')) css_max_rpm_ = raw(b, 'D');
     }
-    // 3. T (select), 4. M6 (change)
+  }
+
+  // 3. T (select), 4. M6 (change), M61 Q (the tool now in the spindle); outputs
+  void change_tools(Block& b, const Codes& k) {
     if (has(b, 'T')) selected_tool_ = integer(b, 'T', 0, 99999);
-    if (m6 != nullptr) b_.tool_change(line_, selected_tool_);
-    if (m61 != nullptr) {
+    if (k.m6 != nullptr) b_.tool_change(line_, selected_tool_);
+    if (k.m61 != nullptr) {
       if (!has(b, 'Q')) fail("'M61' needs Q (the tool in the spindle)");
       selected_tool_ = integer(b, 'Q', 0, 99999);
       b_.tool_change(line_, selected_tool_);
     }
-    if (mio != nullptr) {
-      const int c = static_cast<int>(mio->value);
-      if (c >= 62 && !has(b, 'P')) fail("'" + mio->text + "' needs P (output number)");
+    if (k.mio != nullptr) {
+      const int c = static_cast<int>(k.mio->value);
+      if (c >= 62 && !has(b, 'P')) fail("'" + k.mio->text + "' needs P (output number)");
       if (has(b, 'P')) (void)raw(b, 'P');
     }
-    // 5. spindle, coolant
-    if (mspindle != nullptr) spindle_ = static_cast<int>(mspindle->value);
-    if (mcool != nullptr) coolant_ = static_cast<int>(mcool->value);
-    // 6. dwell
-    if (dwell != 0) {
-      if (!has(b, 'P')) fail("'G4' needs P (dwell time [s])");
-      const double p = raw(b, 'P');
-      if (p < 0) fail("'" + text(b, 'P') + "': dwell time must be >= 0");
-      b_.dwell(line_, p);
-    }
-    // 7. modal settings
-    if (gw[kPlane]) {
-      const int c = code10(*gw[kPlane]);
+  }
+
+  // 7. modal settings: plane, units, cutter compensation, polar, lathe mode, tool length,
+  // work offset, path control, distance modes, retract mode.
+  void set_modes(Block& b, const Codes& k) {
+    if (k.g[kPlane]) {
+      const int c = code10(*k.g[kPlane]);
       plane_ = c == 170 ? Plane::XY : c == 180 ? Plane::ZX : Plane::YZ;
     }
-    if (gw[kUnits]) scale_ = code10(*gw[kUnits]) == 200 ? kInch : 1.0;
-    // kCutter: G40 (compensation off) is the only state the interpreter has.
-    if (gw[kPolar]) {
+    if (k.g[kUnits]) scale_ = code10(*k.g[kUnits]) == 200 ? kInch : 1.0;
+    if (k.g[kCutter]) set_cutter_comp(b, *k.g[kCutter]);
+    if (k.g[kPolar]) {
       if (opt_.machine != MachineKind::LatheC)
-        fail("'" + gw[kPolar]->text + "' (polar interpolation) needs machine kind lathe-c");
-      polar_ = code10(*gw[kPolar]) == 121;
+        fail("'" + k.g[kPolar]->text + "' (polar interpolation) needs machine kind lathe-c");
+      polar_ = code10(*k.g[kPolar]) == 121;
     }
-    if (gw[kLathe]) {
+    if (k.g[kLathe]) {
       // G8 (radius mode) is every mill's state; LinuxCNC accepts it anywhere.
       const bool lathe = opt_.machine == MachineKind::Lathe || opt_.machine == MachineKind::LatheC;
-      if (!lathe && code10(*gw[kLathe]) == 70)
-        fail("'" + gw[kLathe]->text + "' (lathe " + (code10(*gw[kLathe]) == 70 ? "diameter" : "radius") +
-             " mode) needs machine kind lathe");
-      diameter_mode_ = code10(*gw[kLathe]) == 70;
+      if (!lathe && code10(*k.g[kLathe]) == 70)
+        fail("'" + k.g[kLathe]->text + "' (lathe diameter mode) needs machine kind lathe");
+      diameter_mode_ = code10(*k.g[kLathe]) == 70;
     }
-    if (gw[kLength]) {
-      const AxisVector m = b_.to_machine(b_.position());
-      if (code10(*gw[kLength]) == 430) {
-        const int h = has(b, 'H') ? integer(b, 'H', 0, 99999) : b_.tool();
-        b_.set_tool_length_offset(b_.tool_length(h));
-      } else {
-        b_.set_tool_length_offset(0.0);
-      }
-      b_.set_position(b_.from_machine(m));
-    }
-    if (gw[kCoord]) {
-      const int c = code10(*gw[kCoord]);
-      int k = 0;
-      if (c <= 590) k = (c - 540) / 10;
-      else k = 6 + (c - 591);
-      select_wcs(k);
+    if (k.g[kLength]) set_tool_length(b, code10(*k.g[kLength]) == 430);
+    if (k.g[kCoord]) {
+      const int c = code10(*k.g[kCoord]);
+      select_wcs(c <= 590 ? (c - 540) / 10 : 6 + (c - 591));
     }
     // kPath: G61/G61.1/G64 [P tolerance] [Q naive-cam tolerance] are recorded; the emulator
     // stops exactly at corners (docs/nc-frontend.md#motion-model).
-    if (gw[kPath]) {
-      path_mode_ = code10(*gw[kPath]);
+    if (k.g[kPath]) {
+      path_mode_ = code10(*k.g[kPath]);
       if (path_mode_ == 640) {
         if (has(b, 'P')) path_tol_mm_ = len(b, 'P');
         if (has(b, 'Q')) path_q_tol_mm_ = len(b, 'Q');
         if (path_tol_mm_ < 0.0 || path_q_tol_mm_ < 0.0) fail("'G64' tolerances P and Q must be >= 0");
       }
     }
-    if (gw[kDistance]) absolute_ = code10(*gw[kDistance]) == 900;
-    if (gw[kArcDistance]) arc_absolute_ = code10(*gw[kArcDistance]) == 901;
-    if (gw[kRetract]) retract_to_initial_ = code10(*gw[kRetract]) == 980;
+    if (k.g[kDistance]) absolute_ = code10(*k.g[kDistance]) == 900;
+    if (k.g[kArcDistance]) arc_absolute_ = code10(*k.g[kArcDistance]) == 901;
+    if (k.g[kRetract]) retract_to_initial_ = code10(*k.g[kRetract]) == 980;
+  }
 
-    // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing).
-    for (int a = 0; a < kAxes; ++a)
-      if (has(b, kAxisLetters[a]) && !axis_allowed(a) && g10 == 0)
-        fail("word '" + text(b, kAxisLetters[a]) + "' needs an axis the machine lacks (machine kind " + machine_name() + ")");
+  void set_cutter_comp(Block& b, const Word& w) {
+    (void)b;
+    if (code10(w) != 400) fail("unsupported word '" + w.text + "' (cutter radius compensation" + kUseRs274 + ")");
+  }
 
-    // 8. G10, G28/G30, G53; 9. motion
-    if (gw[kMotion]) {
-      const int c = code10(*gw[kMotion]);
+  void set_tool_length(Block& b, bool on) {
+    const AxisVector m = b_.to_machine(b_.position());
+    if (on) {
+      const int h = has(b, 'H') ? integer(b, 'H', 0, 99999) : b_.tool();
+      b_.set_tool_length_offset(b_.tool_length(h));
+    } else {
+      b_.set_tool_length_offset(0.0);
+    }
+    b_.set_position(b_.from_machine(m));
+  }
+
+  // 8. G10, G28/G30, G53; 9. motion
+  void move(Block& b, const Codes& k) {
+    if (k.g[kMotion]) {
+      const int c = code10(*k.g[kMotion]);
       if (c != motion_ && is_cycle(c)) cycle_sticky_ = {};
       if (!is_cycle(c)) cycle_series_ = false;
       motion_ = c;
       if (c == 800) motion_ = -1;
     }
-    if (g10 != 0) {
+    const Word* gm = k.g[kMotion];
+    if (k.g10 != 0) {
       do_g10(b);
-    } else if (g92 != 0) {
-      if (gw[kMotion] != nullptr && any_axis(b))
-        fail("'" + gw[kMotion]->text + "' and 'G92' both use the axis words");
-      do_g92(b, g92);
-    } else if (home != 0) {
-      if (gw[kMotion] != nullptr && any_axis(b))
-        fail("'" + gw[kMotion]->text + "' and 'G" + (home < 300 ? std::string("28") : std::string("30")) +
-             (home % 10 ? ".1" : "") + "' both use the axis words");
-      do_home(b, home);
-    } else if (g53 != 0) {
-      const int c = gw[kMotion] ? code10(*gw[kMotion]) : motion_;
+    } else if (k.g92 != 0) {
+      if (gm != nullptr && any_axis(b)) fail("'" + gm->text + "' and 'G92' both use the axis words");
+      do_g92(b, k.g92);
+    } else if (k.home != 0) {
+      if (gm != nullptr && any_axis(b))
+        fail("'" + gm->text + "' and 'G" + (k.home < 300 ? std::string("28") : std::string("30")) +
+             (k.home % 10 ? ".1" : "") + "' both use the axis words");
+      do_home(b, k.home);
+    } else if (k.g53 != 0) {
+      const int c = gm ? code10(*gm) : motion_;
       if (c != 0 && c != 10) fail("'G53' needs G0 or G1 in the block or in effect");
       if (!absolute_) fail("'G53' needs absolute distance mode (G90)");
-      const AxisVector t = target(b, true);
-      move_line(c, t, f_in_block);
-    } else if (any_axis(b) || (gw[kMotion] != nullptr && (is_cycle(motion_) || motion_ == 20 || motion_ == 30))) {
-      if (motion_ < 0) {
-        for (char L : kAxisLetters)
-          if (has(b, L)) fail("axis word '" + text(b, L) + "' given but no motion mode is in effect");
-      }
-      if (polar_) {
-        if (motion_ != 0 && motion_ != 10) fail("only G0 and G1 are supported in polar interpolation (G12.1)");
-        move_polar(b, f_in_block);
-      } else if (motion_ == 0 || motion_ == 10) move_line(motion_, target(b, false), f_in_block);
-      else if (motion_ == 20 || motion_ == 30) move_arc(b, f_in_block);
-      else if (motion_ >= 0) canned_cycle(b);
+      move_line(c, target(b, true), k.f_in_block);
+    } else if (any_axis(b) || (gm != nullptr && (is_cycle(motion_) || motion_ == 20 || motion_ == 30))) {
+      modal_motion(b, k.f_in_block);
     }
+  }
 
-    // Every word must have been used by something in the block.
+  void modal_motion(Block& b, bool f_in_block) {
+    if (motion_ < 0) {
+      for (char L : kAxisLetters)
+        if (has(b, L)) fail("axis word '" + text(b, L) + "' given but no motion mode is in effect");
+    }
+    if (polar_) {
+      if (motion_ != 0 && motion_ != 10) fail("only G0 and G1 are supported in polar interpolation (G12.1)");
+      move_polar(b, f_in_block);
+    } else if (motion_ == 0 || motion_ == 10) {
+      move_line(motion_, target(b, false), f_in_block);
+    } else if (motion_ == 20 || motion_ == 30) {
+      move_arc(b, f_in_block);
+    } else if (motion_ == 330 || motion_ == 331) {
+      move_synchronised(b);
+    } else if (motion_ == 760) {
+      threading_cycle(b);
+    } else if (motion_ >= 0) {
+      canned_cycle(b);
+    }
+  }
+
+  // Every word must have been used by something in the block.
+  void check_all_words_used(Block& b) const {
     for (char L : {'X', 'Y', 'Z', 'A', 'B', 'C', 'F', 'S', 'T'}) b.used[idx(L)] = b.used[idx(L)] || has(b, L);
     if (has(b, 'D') && !b.used[idx('D')])
-      fail("unsupported word '" + text(b, 'D') + "' (cutter radius compensation" + kUseRs274 + ")");
+      fail("unused word '" + text(b, 'D') + "' (D is a tool number for G41/G42, a diameter for G41.1/G42.1, or the maximum speed for G96)");
     for (int k = 0; k < 26; ++k)
       if (b.has[k] && !b.used[k]) fail("unused word '" + b.text[k] + "' (no G-code in the block uses it)");
+  }
+  // ---- spindle-synchronised motion (G33, G33.1, G76) --------------------------------------
+  // The tool path carries no spindle angle: a synchronised move is a feed move at
+  // K [length/rev] x the spindle speed at its start (docs/nc-frontend.md#lathe).
+  double sync_feed(const std::string& g, double k_mm_per_rev) const {
+    const double rpm = spindle_rpm_now();
+    if (!(rpm > 0.0)) fail("'" + g + "' needs a spindle speed S > 0 (spindle-synchronised motion)");
+    return k_mm_per_rev * rpm;
+  }
 
-    // 10. stops
-    if (mstop != nullptr) {
-      const int c = static_cast<int>(mstop->value);
-      if (c == 2 || c == 30) ended_ = true;
-      else ++pauses_;  // M0/M1: program pause; no motion
+  // G33 K: a straight move synchronised with the spindle. G33.1 K: rigid tapping, to the end
+  // point and back to the start at the same rate (the spindle reverses at the bottom).
+  void move_synchronised(Block& b) {
+    const std::string g = motion_ == 330 ? "G33" : "G33.1";
+    if (!has(b, 'K')) fail("'" + g + "' needs K (distance per revolution)");
+    const double k = len(b, 'K');
+    if (!(k > 0.0)) fail("'" + g + "' needs K > 0 (distance per revolution)");
+    const AxisVector start = b_.position();
+    const AxisVector end = target(b, false);
+    b_.feed(line_, end, sync_feed(g, k), false);
+    if (motion_ == 331) b_.feed(line_, start, sync_feed(g, k), false);
+  }
+
+  // G76 threading cycle, as LinuxCNC: the start point is on the drive line; I is the thread
+  // peak's offset from it (I < 0: external thread), J the first pass depth, K the full depth
+  // (K > J), R the depth degression (pass n at depth J·n^(1/R)), Q the compound slide angle
+  // [deg], H spring passes, E the taper length along Z and L which ends are tapered (1 entry,
+  // 2 exit, 3 both). X words are radii in G8 and diameters in G7; I, J, K are halved in G7 too.
+  struct Thread {
+    double pitch = 0, peak = 0, first = 0, full = 0, degression = 1, tan_q = 0, taper = 0;
+    int springs = 0, taper_ends = 0;
+    double sx = 0, sz = 0, ez = 0, s = 1, dir = -1;  // drive line start, end Z, Z direction, depth direction
+  };
+
+  void threading_cycle(Block& b) {
+    const Thread t = thread_words(b);
+    const AxisVector start = b_.position();
+    double depth = t.first;
+    for (long n = 1; depth < t.full - 1e-9; depth = t.first * std::pow(static_cast<double>(++n), 1.0 / t.degression)) {
+      if (n > kMaxPecks) fail("'G76': more than " + std::to_string(kMaxPecks) + " passes");
+      threading_pass(t, depth);
     }
+    for (int i = 0; i <= t.springs; ++i) threading_pass(t, t.full);
+    AxisVector end = b_.position();
+    end[X] = has(b, 'X') ? (absolute_ ? axis_value(b, X) : start[X] + axis_value(b, X)) : t.sx;
+    end[Z] = t.ez;
+    b_.rapid(line_, end);
+  }
+
+  Thread thread_words(Block& b) {
+    for (char L : {'P', 'Z', 'I', 'J', 'K'})
+      if (!has(b, L)) fail(std::string("'G76' needs ") + L + " (P pitch, Z end, I peak offset, J first depth, K full depth)");
+    for (char L : {'Y', 'A', 'B', 'C'})
+      if (has(b, L)) fail("word '" + text(b, L) + "' cannot be used with 'G76'");
+    Thread t;
+    const double radius = diameter_mode_ ? 0.5 : 1.0;
+    t.pitch = len(b, 'P');
+    t.peak = len(b, 'I') * radius;
+    t.first = len(b, 'J') * radius;
+    t.full = len(b, 'K') * radius;
+    if (has(b, 'R')) t.degression = raw(b, 'R');
+    if (has(b, 'Q')) t.tan_q = std::tan(raw(b, 'Q') * std::numbers::pi / 180.0);
+    if (has(b, 'H')) t.springs = integer(b, 'H', 0, 1000);
+    if (has(b, 'E')) t.taper = len(b, 'E');
+    if (has(b, 'L')) t.taper_ends = integer(b, 'L', 0, 3);
+    if (!(t.pitch > 0.0)) fail("'G76' needs P > 0 (thread pitch)");
+    if (!(t.first > 0.0)) fail("'G76' needs J > 0 (first cut depth)");
+    if (!(t.full > t.first)) fail("'G76': K (full thread depth) must be greater than J (first cut depth)");
+    if (!(t.degression > 0.0)) fail("'G76' needs R > 0 (depth degression)");
+    if (t.taper < 0.0) fail("'G76' needs E >= 0 (taper length)");
+    const AxisVector p = b_.position();
+    t.sx = p[X], t.sz = p[Z];
+    const double z = has(b, 'Z') ? len(b, 'Z') : 0.0;
+    t.ez = absolute_ ? z : p[Z] + z;
+    if (std::abs(t.ez - t.sz) < 1e-9) fail("'G76' needs a Z end point different from the start");
+    t.s = t.ez < t.sz ? -1.0 : 1.0;
+    t.dir = t.peak > 0.0 ? 1.0 : -1.0;  // I > 0: internal thread, cuts towards +X
+    return t;
+  }
+
+  // One pass at `depth`: rapid to the retract X beside the start, in to the cut (with the
+  // entry taper as a synchronised move), along the thread (exit taper), rapid back out.
+  void threading_pass(const Thread& t, double depth) {
+    const double zoff = depth * t.tan_q;
+    const double zs = t.sz + t.s * zoff, ze = t.ez - t.s * (t.full * t.tan_q - zoff);
+    const double cut = t.sx + t.peak + t.dir * depth, crest = cut - t.dir * t.full;
+    const double safe = t.sx - t.dir * (t.full - depth);
+    const double taper_k = t.taper > 0.0 ? t.pitch * std::hypot(t.full, t.taper) / t.taper : t.pitch;
+    auto at = [&](double x, double z) {
+      AxisVector v = b_.position();
+      v[X] = x, v[Z] = z;
+      return v;
+    };
+    b_.rapid(line_, at(safe, zs));
+    if ((t.taper_ends & 1) != 0 && t.taper > 0.0) {
+      b_.feed(line_, at(crest, zs), sync_feed("G76", taper_k), false);
+      b_.feed(line_, at(cut, zs + t.s * t.taper), sync_feed("G76", taper_k), false);
+    } else {
+      b_.rapid(line_, at(cut, zs));
+    }
+    if ((t.taper_ends & 2) != 0 && t.taper > 0.0) {
+      b_.feed(line_, at(cut, ze - t.s * t.taper), sync_feed("G76", t.pitch), false);
+      b_.feed(line_, at(crest, ze), sync_feed("G76", taper_k), false);
+    } else {
+      b_.feed(line_, at(cut, ze), sync_feed("G76", t.pitch), false);
+    }
+    b_.rapid(line_, at(safe, b_.position()[Z]));
   }
 
   static bool is_cycle(int c) { return c == 810 || c == 820 || c == 830 || c == 730; }
@@ -654,11 +796,7 @@ class Interpreter {
   // Spindle speed at the current point [rpm]: S in G97; in G96 the speed that gives the
   // surface speed S at the current radius |X| (capped by G96 D), as LinuxCNC computes it.
   double spindle_rpm_now() const {
-    if (!css_) return spindle_rpm_;
-    const double surface_mm_per_min = spindle_rpm_ * (scale_ == 1.0 ? 1000.0 : 304.8);
-    const double r = std::abs(b_.position()[X]);
-    double rpm = r > 1e-6 ? surface_mm_per_min / (2.0 * std::numbers::pi * r) : 1e300;
-    if (css_max_rpm_ > 0.0) rpm = std::min(rpm, css_max_rpm_);
+    const double rpm = detail::spindle_rpm(spindle_rpm_, css_, css_max_rpm_, scale_, b_.position()[X]);
     if (rpm > 1e9) fail("'G96' at the spindle axis needs a maximum speed (G96 D)");
     return rpm;
   }
