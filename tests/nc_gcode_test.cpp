@@ -348,7 +348,7 @@ TEST_P(GcodeErrors, ExactMessage) { EXPECT_EQ(error_of(GetParam().program), GetP
 INSTANTIATE_TEST_SUITE_P(
     Messages, GcodeErrors,
     ::testing::Values(
-        ErrorCase{"G0 X1\nG41 X1\n", "t.ngc:2: unsupported word 'G41' (cutter radius compensation; use --interpreter rs274)"},
+        ErrorCase{"G41.1 D2\nG42.1 D2\n", "t.ngc:2: 'G42.1': cutter radius compensation is already on (G40 first)"},
         ErrorCase{"G0 X1\n\no100 sub\n", "t.ngc:3: 'o100 sub' is never closed"},
         ErrorCase{"#1 = [1 / 0]\n", "t.ngc:1: division by zero"},
         ErrorCase{"G0 X#<nope>\n", "t.ngc:1: named parameter '#<NOPE>' is not defined"},
@@ -362,7 +362,7 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"M98 P100\n", "t.ngc:1: unsupported word 'M98' (not supported by the built-in interpreter; use --interpreter rs274)"},
         ErrorCase{"G1 X1 F100 E5\n", "t.ngc:1: unused word 'E5' (no G-code in the block uses it)"},
         ErrorCase{"G1 X1 F100 D3\n", "t.ngc:1: unused word 'D3' (D is a tool number for G41/G42, a diameter for G41.1/G42.1, or the maximum speed for G96)"},
-        ErrorCase{"G1 F100\nG42 D3 X1\n", "t.ngc:2: unsupported word 'G42' (cutter radius compensation; use --interpreter rs274)"},
+        ErrorCase{"G1 F100\nG42 D3 X1\n", "t.ngc:2: 'D3': tool 3 has no diameter in the tool table"},
         ErrorCase{"G1 X1 F100 U5\n", "t.ngc:1: unsupported word 'U5' (axes U, V, W are not supported)"},
         ErrorCase{"(comment\nG1 X1\n", "t.ngc:1: unclosed comment '('"},
         ErrorCase{"G0 X1..2\n", "t.ngc:1: unexpected character '.'"},

@@ -59,6 +59,29 @@ void cross_check(const std::string& text, const GcodeOptions& o, double tol = 1e
         << "segment " << i;
 }
 
+// Both front ends on `text` (rs274 when installed): every vertex of each path within tol of
+// the other path, in order (arcs are chorded by the same code, so chord counts may differ
+// by the 4 decimals rs274 prints).
+void cross_check_path(const std::string& text, const GcodeOptions& o, double tol = 1e-3) {
+  if (find_rs274().empty()) return;
+  const auto dir = std::filesystem::temp_directory_path() / ("lbr-motion-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "p.ngc").string();
+  std::ofstream(path) << text;
+  const Toolpath theirs = run_rs274(path, o);
+  std::filesystem::remove_all(dir);
+  const Toolpath mine = run(text, o);
+  EXPECT_LE(lbr::test::directed_distance(mine, theirs, tol), tol);
+  EXPECT_LE(lbr::test::directed_distance(theirs, mine, tol), tol);
+}
+
+GcodeOptions mill_with_tools() {
+  GcodeOptions o;
+  o.tool_diameters = {{1, 10.0}, {2, 4.0}};
+  o.chord_tol_mm = 0.0005;
+  return o;
+}
+
 // ---- G33, G33.1 ----------------------------------------------------------------------------
 
 TEST(NgcSpindleSync, G33FeedsAtKTimesTheSpindleSpeed) {
@@ -133,6 +156,94 @@ TEST(NgcThreading, ErrorsNameTheWord) {
             "t.ngc:2: 'G76': K (full thread depth) must be greater than J (first cut depth)");
   EXPECT_EQ(error_of("S100\nG76 P2 Z-20 I-1.5 K1\n", lathe()),
             "t.ngc:2: 'G76' needs J (P pitch, Z end, I peak offset, J first depth, K full depth)");
+}
+
+// ---- cutter radius compensation -------------------------------------------------------------
+
+// The last end point of the segments of `line`.
+AxisVector end_of_line(const Toolpath& tp, int line) {
+  AxisVector e{};
+  for (const Segment& s : tp.segments)
+    if (s.line == line) e = s.end;
+  return e;
+}
+
+TEST(NgcCutterComp, SquareLeftAndRightWithEntryAndExit) {
+  // Counter-clockwise 20 mm square from (0, 0), G41 with a 10 mm tool (radius 5): the entry
+  // from (-10, -10) ends beside (0, 0), square to its direction: (0, 0) + 5 (-sin 45, cos 45).
+  // Its corner with the first side is convex (a right turn): an arc around (0, 0) to (0, 5).
+  // The other corners turn left, towards the tool: concave, the sides meet at X15 Y5, X15
+  // Y15, X5 Y15; the last side ends beside (0, 0) at (5, 0) when G40 closes it.
+  const std::string prog = "G21 G90 G17\nG0 X-10 Y-10 Z5\nG1 Z-1 F300\nG41 D1 G1 X0 Y0\nG1 X20\nG1 Y20\nG1 X0\nG1 Y0\n"
+                           "G40 G1 X-10 Y-10\nM2\n";
+  const Toolpath tp = run(prog, mill_with_tools());
+  const double s45 = std::sqrt(0.5) * 5.0;
+  const double want[][3] = {{4, -s45, s45}, {5, 15, 5}, {6, 15, 15}, {7, 5, 15}, {8, 5, 0}, {9, -10, -10}};
+  for (const auto& w : want) {
+    EXPECT_NEAR(end_of_line(tp, static_cast<int>(w[0]))[X], w[1], 1e-9) << "line " << w[0];
+    EXPECT_NEAR(end_of_line(tp, static_cast<int>(w[0]))[Y], w[2], 1e-9) << "line " << w[0];
+  }
+  for (const Segment& s : tp.segments) {  // the corner arc of line 5 stays 5 mm from (0, 0)
+    if (s.line == 5 && s.end[X] < 1.0) {
+      EXPECT_NEAR(std::hypot(s.end[X], s.end[Y]), 5.0, 1e-9);
+    }
+  }
+  cross_check_path(prog, mill_with_tools());
+  // G42 on the same square: outside, every corner convex: a quarter arc around each corner.
+  std::string right = prog;
+  right.replace(right.find("G41"), 3, "G42");
+  const Toolpath rp = run(right, mill_with_tools());
+  double xmax = -1e9, ymin = 1e9;
+  for (const Segment& s : rp.segments) xmax = std::max(xmax, s.end[X]), ymin = std::min(ymin, s.end[Y]);
+  EXPECT_NEAR(xmax, 25.0, 1e-9);
+  EXPECT_NEAR(ymin, -10.0, 1e-9);  // the exit point; the path itself stays at Y >= -5
+  cross_check_path(right, mill_with_tools());
+}
+
+TEST(NgcCutterComp, ArcsInXYAndXZAndTheDiameterForm) {
+  // Lines and arcs both ways, convex and concave, R and IJK arcs (LinuxCNC's comp.ngc shape).
+  const std::string xy = "G21 G90 G17 F300\nG0 X-5 Y-5 Z0\nG42 D2\nG1 X0 Y0\nG1 Y25\nG3 R6.25 X-6.25 Y31.25\nG1 X-12.5\n"
+                         "G2 R6.25 X-18.75 Y37.5\nG1 Y43.75\nG40\nG0 X5 Y-5\nG41 D2\nG1 X0 Y0\nG1 Y25\n"
+                         "G3 X-6.25 Y31.25 I-6.25 J0\nG1 X-12.5\nG2 X-18.75 Y37.5 I0 J6.25\nG1 Y43.75\nG40\nM2\n";
+  cross_check_path(xy, mill_with_tools());
+  const std::string xz = "G21 G90 G18 F300\nG0 X-5 Z-5 Y0\nG42 D2\nG1 X0 Z0\nG1 Z25\nG2 R6.25 X-6.25 Z31.25\n"
+                         "G1 X-12.5\nG3 R6.25 X-18.75 Z37.5\nG1 Z43.75\nG40\nM2\n";
+  cross_check_path(xz, mill_with_tools());
+  // G41.1 D4 (diameter in the block) gives the path of G41 D2 (tool 2: 4 mm).
+  std::string d = xy;
+  for (std::size_t at; (at = d.find("D2")) != std::string::npos;) d.replace(at, 2, "D4");
+  for (std::size_t at; (at = d.find("G41 ")) != std::string::npos;) d.replace(at, 4, "G41.1 ");
+  for (std::size_t at; (at = d.find("G42 ")) != std::string::npos;) d.replace(at, 4, "G42.1 ");
+  const auto a = ends(run(xy, mill_with_tools())), b = ends(run(d, mill_with_tools()));
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i][X], b[i][X], 1e-12);
+}
+
+TEST(NgcCutterComp, ArcEntryHelixAndZMovesInside) {
+  // comp311_2-like: the first move after G41 is an arc; Z-only moves between corners.
+  GcodeOptions o = mill_with_tools();
+  const std::string prog = "G21 G90 G17 F300\nG0 X30 Y100 Z5\nG1 Z0\nG41 D2\nG3 X50 Y80 I20\nG2 X70 Y60 J-20\nG1 Y0\n"
+                           "G1 Z-1\nG1 X0\nG2 X0 Y0 Z-2 I0 J10\nG1 X-10 Y20\nG40\nG1 X-20 Y30\nM2\n";
+  cross_check_path(prog, o);
+}
+
+TEST(NgcCutterComp, GougingCornersAreRefusedWithTheLine) {
+  // A 4 mm wide slot, cut inside with a 10 mm tool: the concave corners cannot be reached.
+  EXPECT_EQ(error_of("G21 G90 F100\nG0 X-10 Y-10\nG41 D1 G1 X0 Y0\nG1 X20\nG1 Y4\nG1 X0\nG1 Y0\nG40 G1 X-10\nM2\n",
+                     mill_with_tools()),
+            "t.ngc:6: straight feed in a concave corner cannot be reached by the tool (radius 5 mm) without gouging");
+  EXPECT_EQ(error_of("G21 G90 F100\nG0 X0 Y0\nG41 D1 G1 X3 Y0\n", mill_with_tools()),
+            "t.ngc:3: the cutter compensation entry move (3 mm in the plane) is not longer than the tool radius (5 mm)");
+  EXPECT_EQ(error_of("G21 G90 F100\nG0 X-20 Y0\nG41 D1 G1 X0 Y0\nG3 X8 Y0 I4\n", mill_with_tools()),
+            "t.ngc:4: the tool radius (5 mm) is not less than the arc radius (4 mm) with cutter compensation");
+  EXPECT_EQ(error_of("G21 F100\nG41 D1\nT2 M6\n", mill_with_tools()),
+            "t.ngc:3: cannot change tools with cutter radius compensation on (G40 first)");
+  EXPECT_EQ(error_of("G21 F100\nG41 D1\nG1 X20 Y0\nG81 X1 R1 Z-1\n", mill_with_tools()),
+            "t.ngc:4: 'G81' cannot be used with cutter radius compensation on (G40 first)");
+  EXPECT_EQ(error_of("G21 F100\nG41 D1\nG1 X20 Y0\nG40\nG2 X30 Y0 R5\n", mill_with_tools()),
+            "t.ngc:5: 'G2': the move just after G40 must be a straight line, not an arc (as LinuxCNC)");
+  EXPECT_EQ(error_of("G41 D7\n", mill_with_tools()), "t.ngc:1: 'D7': tool 7 has no diameter in the tool table");
+  EXPECT_EQ(error_of("G19 G41 D1\n", mill_with_tools()), "t.ngc:1: cutter radius compensation needs plane G17 (XY) or G18 (XZ)");
 }
 
 }  // namespace

@@ -100,36 +100,7 @@ GcodeOptions recorded_options(double chord_tol_mm) {
   return o;
 }
 
-// Every vertex of `a` lies within tol of `b`'s polyline, visited in order. Returns the
-// largest distance seen, or +inf when a vertex has no match.
-double directed_distance(const Toolpath& a, const Toolpath& b, double tol) {
-  std::size_t j = 0;
-  AxisVector bfrom = b.start;
-  double worst = 0.0;
-  for (const Segment& s : a.segments) {
-    if (s.kind != SegmentKind::Rapid && s.kind != SegmentKind::Feed) continue;
-    std::size_t k = j;
-    AxisVector from = bfrom;
-    bool found = false;
-    for (; k < b.segments.size(); ++k) {
-      const double d = lbr::test::axis_dist_to_segment(s.end, from, b.segments[k].end);
-      if (d <= tol) {
-        worst = std::max(worst, d);
-        found = true;
-        break;
-      }
-      from = b.segments[k].end;
-    }
-    if (!found) {
-      ADD_FAILURE() << "vertex of line " << s.line << " (" << s.end[X] << ", " << s.end[Y] << ", " << s.end[Z]
-                    << ") is not on the other path";
-      return INFINITY;
-    }
-    j = k;
-    bfrom = from;
-  }
-  return worst;
-}
+using lbr::test::directed_distance;
 
 struct Event {
   SegmentKind kind;

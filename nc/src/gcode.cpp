@@ -16,6 +16,7 @@
 #include <sstream>
 #include <vector>
 
+#include "cutter_comp.hpp"
 #include "ngc_control.hpp"
 #include "ngc_expr.hpp"
 #include "path_builder.hpp"
@@ -94,6 +95,7 @@ class Interpreter {
 
   Toolpath run(const std::string& text) {
     flow_.run(text, name_);
+    if (comp_.active()) (void)comp_.off();
     return b_.take();
   }
 
@@ -115,10 +117,13 @@ class Interpreter {
     return ended_;
   }
 
+  // Program position of the controlled point (with cutter compensation, the programmed one).
+  AxisVector pos() const { return comp_.active() ? comp_.programmed() : b_.position(); }
+
   // ---- system parameters (read-only, computed when read; LinuxCNC's numbering and names) ----
   double units(double mm) const { return mm / scale_; }
   bool system_numbered(int n, double& v) const {
-    const AxisVector p = b_.position();
+    const AxisVector p = pos();
     auto axis = [&](const AxisVector& a, int k) { return k < kAxes ? (k <= Z ? units(a[k]) : a[k]) : 0.0; };
     if (n >= 5161 && n <= 5169) v = axis(g28_, n - 5161);
     else if (n >= 5181 && n <= 5189) v = axis(g30_, n - 5181);
@@ -140,7 +145,7 @@ class Interpreter {
   }
   bool system_named(const std::string& n, double& v) const {
     if (n.empty() || n[0] != '_') return false;
-    const AxisVector p = b_.position();
+    const AxisVector p = pos();
     static const char* const kAxisNames[] = {"_X", "_Y", "_Z", "_A", "_B", "_C"};
     for (int a = 0; a < kAxes; ++a)
       if (n == kAxisNames[a]) return v = a <= Z ? units(p[a]) : p[a], true;
@@ -309,7 +314,7 @@ class Interpreter {
         if (has(b, kAxisLetters[a])) m[a] = axis_value(b, a);
       return b_.from_machine(m);
     }
-    AxisVector t = b_.position();
+    AxisVector t = pos();
     for (int a = 0; a < kAxes; ++a) {
       if (!has(b, kAxisLetters[a])) continue;
       const double v = axis_value(b, a);
@@ -363,6 +368,7 @@ class Interpreter {
   struct Codes {
     std::array<const Word*, kGroups> g{};
     int dwell = 0, g10 = 0, home = 0, g53 = 0, g92 = 0;  // non-modal codes x 10 (home: 280, 281, 300, 301)
+    const Word* nonmodal = nullptr;                      // G10, G28, G30, G53 or G92 (one per block)
     const Word* mstop = nullptr;
     const Word* mspindle = nullptr;
     const Word* m6 = nullptr;
@@ -374,6 +380,7 @@ class Interpreter {
 
   void execute(Block& b) {
     Codes k = group_codes(b);
+    check_comp_allows(k);
     set_feed_and_speed(b, k);
     change_tools(b, k);
     if (k.mspindle != nullptr) spindle_ = static_cast<int>(k.mspindle->value);
@@ -382,7 +389,8 @@ class Interpreter {
       if (!has(b, 'P')) fail("'G4' needs P (dwell time [s])");
       const double p = raw(b, 'P');
       if (p < 0) fail("'" + text(b, 'P') + "': dwell time must be >= 0");
-      b_.dwell(line_, p);
+      if (comp_.active()) comp_.dwell(line_, p);
+      else b_.dwell(line_, p);
     }
     set_modes(b, k);
     // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing).
@@ -393,8 +401,12 @@ class Interpreter {
     check_all_words_used(b);
     if (k.mstop != nullptr) {
       const int c = static_cast<int>(k.mstop->value);
-      if (c == 2 || c == 30) ended_ = true;
-      else ++pauses_;  // M0/M1: program pause; no motion
+      if (c == 2 || c == 30) {
+        if (comp_.active()) (void)comp_.off();
+        ended_ = true;
+      } else {
+        ++pauses_;
+      }  // M0/M1: program pause; no motion
     }
   }
 
@@ -418,6 +430,7 @@ class Interpreter {
           (slot == &k.home && (k.g10 != 0 || k.g92 != 0)) || (slot == &k.g92 && (k.g10 != 0 || k.home != 0)))
         fail("'" + w->text + "' cannot be combined with another non-modal G-code in the block");
       *slot = c;
+      if (c != 40) k.nonmodal = w;
     }
     for (const Word& w : b.m) {
       const int c = static_cast<int>(std::lround(w.value));
@@ -523,9 +536,53 @@ class Interpreter {
     if (k.g[kRetract]) retract_to_initial_ = code10(*k.g[kRetract]) == 980;
   }
 
+  // G40 (off), G41/G42 [D tool number] (left/right by the radius of tool D, default: the
+  // loaded tool), G41.1/G42.1 D diameter (program units; negative swaps the side), as LinuxCNC.
   void set_cutter_comp(Block& b, const Word& w) {
-    (void)b;
-    if (code10(w) != 400) fail("unsupported word '" + w.text + "' (cutter radius compensation" + kUseRs274 + ")");
+    const int c = code10(w);
+    if (c == 400) {
+      if (comp_.active()) arc_after_g40_ = comp_.off();
+      return;
+    }
+    if (comp_.active()) fail("'" + w.text + "': cutter radius compensation is already on (G40 first)");
+    int side = c == 410 || c == 411 ? 1 : -1;
+    double radius = 0.0;
+    if (c == 411 || c == 421) {
+      if (!has(b, 'D')) fail("'" + w.text + "' needs D (tool diameter)");
+      radius = 0.5 * len(b, 'D');
+      if (radius < 0.0) side = -side, radius = -radius;
+    } else if (has(b, 'D')) {
+      const int t = integer(b, 'D', 0, 99999);
+      if (t != 0 && opt_.tool_diameters.count(t) == 0)
+        fail("'" + text(b, 'D') + "': tool " + std::to_string(t) + " has no diameter in the tool table");
+      radius = 0.5 * tool_diameter(t);
+    } else {
+      radius = 0.5 * tool_diameter(b_.tool());
+    }
+    comp_.on(side, radius, plane_);
+  }
+
+  // While cutter compensation is on, LinuxCNC refuses what would move the frame or the tool
+  // under the open move; so does the built-in interpreter.
+  void check_comp_allows(const Codes& k) const {
+    if (!comp_.active()) return;
+    auto refuse = [&](const std::string& what) { fail(what + " with cutter radius compensation on (G40 first)"); };
+    if (k.m6 != nullptr || k.m61 != nullptr) refuse("cannot change tools");
+    if (k.g[kLength] != nullptr) refuse("cannot change the tool length offset");
+    if (k.g[kPlane] != nullptr && k.g[kCutter] == nullptr) refuse("cannot change the plane");
+    if (k.g[kUnits] != nullptr && k.g[kCutter] == nullptr) refuse("cannot change units");
+  }
+  void check_comp_allows_motion(const Codes& k) const {
+    if (!comp_.active()) return;
+    const Word* w = k.g10 != 0 || k.g92 != 0 || k.home != 0 || k.g53 != 0 || k.g[kCoord] != nullptr || k.g[kPolar] != nullptr
+                        ? nonmodal_word(k)
+                        : nullptr;
+    if (w != nullptr) fail("'" + w->text + "' cannot be used with cutter radius compensation on (G40 first)");
+  }
+  const Word* nonmodal_word(const Codes& k) const {
+    if (k.g[kCoord] != nullptr) return k.g[kCoord];
+    if (k.g[kPolar] != nullptr) return k.g[kPolar];
+    return k.nonmodal;
   }
 
   void set_tool_length(Block& b, bool on) {
@@ -548,6 +605,7 @@ class Interpreter {
       motion_ = c;
       if (c == 800) motion_ = -1;
     }
+    check_comp_allows_motion(k);
     const Word* gm = k.g[kMotion];
     if (k.g10 != 0) {
       do_g10(b);
@@ -570,6 +628,8 @@ class Interpreter {
   }
 
   void modal_motion(Block& b, bool f_in_block) {
+    if (comp_.active() && motion_ > 30)
+      fail("'" + motion_name() + "' cannot be used with cutter radius compensation on (G40 first)");
     if (motion_ < 0) {
       for (char L : kAxisLetters)
         if (has(b, L)) fail("axis word '" + text(b, L) + "' given but no motion mode is in effect");
@@ -588,6 +648,11 @@ class Interpreter {
     } else if (motion_ >= 0) {
       canned_cycle(b);
     }
+  }
+
+  std::string motion_name() const {
+    const int c = motion_;
+    return "G" + std::to_string(c / 10) + (c % 10 != 0 ? "." + std::to_string(c % 10) : std::string());
   }
 
   // Every word must have been used by something in the block.
@@ -802,7 +867,10 @@ class Interpreter {
   }
 
   void move_line(int c, const AxisVector& t, bool f_in_block) {
-    if (c == 0) {
+    arc_after_g40_ = false;
+    if (comp_.active()) {
+      comp_.line(line_, c == 0, t, c == 0 ? 0.0 : feed_for_move("G1", f_in_block), inverse_time_);
+    } else if (c == 0) {
       b_.rapid(line_, t);
     } else {
       const double f = feed_for_move("G1", f_in_block);
@@ -872,6 +940,7 @@ class Interpreter {
 
   void move_arc(Block& b, bool f_in_block) {
     const std::string g = motion_ == 20 ? "G2" : "G3";
+    if (arc_after_g40_) fail("'" + g + "': the move just after G40 must be a straight line, not an arc (as LinuxCNC)");
     const detail::PlaneAxes ax = detail::plane_axes(plane_);
     static constexpr char kCentre[3] = {'I', 'J', 'K'};  // centre word of X, Y, Z
     const char cu_l = kCentre[ax.u], cv_l = kCentre[ax.v];
@@ -883,7 +952,7 @@ class Interpreter {
     int turns = 1;
     if (has(b, 'P')) turns = integer(b, 'P', 1, 1000);
     const double f = feed_for_move(g, f_in_block);
-    const AxisVector start = b_.position();
+    const AxisVector start = pos();
     const AxisVector end = target(b, false);
     const double du = end[ax.u] - start[ax.u], dv = end[ax.v] - start[ax.v];
     double cu = 0.0, cv = 0.0;
@@ -920,7 +989,8 @@ class Interpreter {
       if (err > 0.002 && err > 0.001 * r0)
         fail("'" + g + "' end point is off the circle: start radius " + fmt(r0) + " mm, end radius " + fmt(r1) + " mm");
     }
-    b_.arc(line_, plane_, end, cu, cv, motion_ == 30 ? turns : -turns, f, inverse_time_);
+    if (comp_.active()) comp_.arc(line_, end, cu, cv, motion_ == 30 ? turns : -turns, f, inverse_time_);
+    else b_.arc(line_, plane_, end, cu, cv, motion_ == 30 ? turns : -turns, f, inverse_time_);
   }
 
   void canned_cycle(Block& b) {
@@ -1026,6 +1096,8 @@ class Interpreter {
   detail::Params params_;
   detail::ExprReader expr_;
   detail::ControlFlow flow_;
+  detail::CutterComp comp_{b_, [this](const std::string& m) { fail(m); }};
+  bool arc_after_g40_ = false;  // the move after G40 must be straight (LinuxCNC)
   std::vector<detail::ParamAssign> pending_;
   std::array<AxisVector, 9> offsets_;
   AxisVector g28_, g30_;
