@@ -41,6 +41,7 @@ struct BatchOptions {
   std::vector<std::string> tools;
   double level_spacing = 0.0;
   int threads = -1;
+  int start_tool = -1;  // --start-tool (-1: the profile's [nc] start_tool)
   bool quiet = false;
   bool sampled = false;
   // rendering (gfx/)
@@ -61,7 +62,15 @@ struct ViewCliOptions {
 
 struct EmulateOptions {
   std::string program, profile, period, out = "samples.csv", interpreter = "builtin";
+  int start_tool = -1;  // --start-tool (-1: the profile's [nc] start_tool)
 };
+
+// --start-tool N: the tool in the spindle at program start (overrides [nc] start_tool).
+void add_start_tool_option(CLI::App* c, int& start_tool) {
+  c->add_option("--start-tool", start_tool,
+                "Tool in the spindle at program start (0 = empty; default: the profile's [nc] start_tool)")
+      ->check(CLI::Range(0, 99999));
+}
 
 // DIR/NAME as the user would type it ("out/" + metrics.json -> out/metrics.json, not out//).
 std::string out_file(const std::string& dir, const std::string& name) {
@@ -94,6 +103,7 @@ double parse_period_ms(const std::string& s) {
 int run_emulate_command(const EmulateOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
   if (!o.period.empty()) profile.sample_period_ms = parse_period_ms(o.period);
+  if (o.start_tool >= 0) profile.start_tool = o.start_tool;
   const nc::Toolpath path = app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   nc::Emulator em(path, app::emulator_limits(profile));
   const std::uint64_t n = app::write_samples_csv(o.out, em);
@@ -169,6 +179,7 @@ app::Profile batch_profile(const BatchOptions& o) {
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
   if (o.threads >= 0) profile.threads = o.threads;
+  if (o.start_tool >= 0) profile.start_tool = o.start_tool;
   return profile;
 }
 
@@ -493,6 +504,7 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
                     "G-code front end: builtin, or rs274 (LinuxCNC's interpreter, package linuxcnc-uspace)")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  add_start_tool_option(batch, b.start_tool);
   batch->add_flag("--sampled", b.sampled,
                   "Run the kernel on the machine emulator's sampled stream (as live mode sees it) instead of the "
                   "interpreted segments");
@@ -527,6 +539,7 @@ CLI::App* add_view_command(CLI::App& cli, BatchOptions& vb, ViewCliOptions& vv) 
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
   view->add_option("--profile", vb.profile, "Machine profile (TOML)");
+  add_start_tool_option(view, vb.start_tool);
   view->add_option("--stock", vb.stock, "Override the stock (as for batch)");
   view->add_option("--tool", vb.tools, "Add or override a tool (as for batch)")->take_all();
   view->add_option("--level-spacing", vb.level_spacing, "Level spacing Δ [mm]")->check(CLI::Range(0.001, 1000.0));
@@ -590,6 +603,7 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateOptions& em) {
   emu->add_option("--interpreter", em.interpreter, "G-code front end: builtin or rs274")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  add_start_tool_option(emu, em.start_tool);
   return emu;
 }
 
