@@ -380,7 +380,7 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"G81 X1 Z-1 F100\n", "t.ngc:1: canned cycle 'G81' needs R and Z"},
         ErrorCase{"G83 X1 Z-1 R1 F100\n", "t.ngc:1: 'G83' needs Q > 0 (peck depth)"},
         ErrorCase{"G0 Z0\nG81 X1 Z1 R-1 F100\n", "t.ngc:2: canned cycle 'G81': R (-1) is below Z (1)"},
-        ErrorCase{"G18 G81 X1 Z-1 R1 F100\n", "t.ngc:1: canned cycle 'G81' needs plane G17 (XY)"},
+        ErrorCase{"G18 G81 X1 Z-1 R1 F100\n", "t.ngc:1: canned cycle 'G81' needs R and Y"},
         ErrorCase{"G4\n", "t.ngc:1: 'G4' needs P (dwell time [s])"},
         ErrorCase{"G10 L1 P1 Z0\n", "t.ngc:1: 'G10' needs L2 or L20 (work offsets); 'L1' is not supported"},
         ErrorCase{"T1.5 M6\n", "t.ngc:1: 'T1.5': expected an integer in [0, 99999]"},

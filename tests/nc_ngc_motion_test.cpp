@@ -158,6 +158,32 @@ TEST(NgcThreading, ErrorsNameTheWord) {
             "t.ngc:2: 'G76' needs J (P pitch, Z end, I peak offset, J first depth, K full depth)");
 }
 
+// ---- canned cycles in G18 and G19 ------------------------------------------------------------
+
+TEST(NgcCannedCycles, DrillAlongTheThirdAxisOfEveryPlane) {
+  // G18: holes along Y at X Z positions; G19: along X at Y Z positions. G98 returns to the
+  // level the series began at (Y10, X10), G99 to R.
+  const std::string prog = "G21 G90 F100\nG0 X5 Y10 Z5\nG18 G98 G81 X7 Z3 Y-4 R2\nX9\nG80\nG0 X10 Y0 Z0\n"
+                           "G19 G99 G83 Y6 Z8 X-5 R1 Q2.5\nG80\nG17\nM2\n";
+  const auto e = ends(run(prog));
+  ASSERT_GE(e.size(), 8u);
+  // First hole: over X7 Z3 at Y10, down to R (Y2), feed to Y-4, back to Y10.
+  EXPECT_DOUBLE_EQ(e[1][X], 7.0);
+  EXPECT_DOUBLE_EQ(e[1][Z], 3.0);
+  EXPECT_DOUBLE_EQ(e[1][Y], 10.0);
+  EXPECT_DOUBLE_EQ(e[2][Y], 2.0);
+  EXPECT_DOUBLE_EQ(e[3][Y], -4.0);
+  EXPECT_DOUBLE_EQ(e[4][Y], 10.0);
+  EXPECT_DOUBLE_EQ(e[5][X], 9.0);
+  cross_check(prog, {});
+  // Regression: without G98/G99 the retract mode is G99 (R plane), as LinuxCNC's interpreter
+  // starts (the built-in interpreter started in G98).
+  const std::string dflt = "G21 G90 F100\nG0 X5 Y10 Z10\nG81 X1 Y1 Z-1 R2\nX2\nM2\n";
+  EXPECT_DOUBLE_EQ(ends(run(dflt))[4][Z], 2.0);
+  cross_check(dflt, {});
+  cross_check("G21 G90 F100\nG0 X5 Y10 Z5\nG18 G91 G73 X2 Z1 Y-6 R-2 Q1.5 L3\nG90 G80\nG19 G82 Y1 Z2 X1 R4 P0.5\nM2\n", {});
+}
+
 // ---- cutter radius compensation -------------------------------------------------------------
 
 // The last end point of the segments of `line`.

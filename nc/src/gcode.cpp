@@ -993,15 +993,60 @@ class Interpreter {
     else b_.arc(line_, plane_, end, cu, cv, motion_ == 30 ? turns : -turns, f, inverse_time_);
   }
 
+  // Drilling cycles in the selected plane, as LinuxCNC: the hole axis w is Z in G17, Y in G18,
+  // X in G19; the positions are the plane's other two axis words; R and the depth word (the
+  // w axis letter) are along w.
   void canned_cycle(Block& b) {
     const std::string g = motion_ == 810 ? "G81" : motion_ == 820 ? "G82" : motion_ == 830 ? "G83" : "G73";
-    if (plane_ != Plane::XY) fail("canned cycle '" + g + "' needs plane G17 (XY)");
+    const detail::PlaneAxes ax = detail::plane_axes(plane_);
+    const char wl = kAxisLetters[ax.w];
+    cycle_words(b, g, wl);
+    const CycleSticky& cs = cycle_sticky_;
+    const double f = feed_for_move(g, has(b, 'F'));
+    int repeats = 1;
+    if (has(b, 'L')) repeats = integer(b, 'L', 0, static_cast<int>(kMaxRepeats));
+    AxisVector p = pos();
+    const double r = absolute_ ? cs.r : p[ax.w] + cs.r;
+    const double bottom = absolute_ ? cs.z : r + cs.z;
+    if (bottom > r) fail("canned cycle '" + g + "': R (" + fmt(r) + ") is below " + wl + " (" + fmt(bottom) + ")");
+    if ((motion_ == 830 || motion_ == 730) && (r - bottom) / cs.q > static_cast<double>(kMaxPecks))
+      fail("'" + g + "': more than " + std::to_string(kMaxPecks) + " pecks");
+    // G98 retracts to the initial level: the hole-axis position before this series of
+    // contiguous canned cycle blocks began (raised to R when it started below R), as LinuxCNC.
+    if (!cycle_series_) {
+      cycle_series_ = true;
+      cycle_initial_z_ = p[ax.w];
+      if (p[ax.w] < r) {
+        p[ax.w] = r;
+        b_.rapid(line_, p);
+        cycle_initial_z_ = r;
+      }
+    }
+    double old_w = retract_to_initial_ ? std::max(cycle_initial_z_, r) : p[ax.w];
+    const double clear = retract_to_initial_ ? std::max(cycle_initial_z_, r) : r;
+    double hu = p[ax.u], hv = p[ax.v];
+    const char ul = kAxisLetters[ax.u], vl = kAxisLetters[ax.v];
+    const double du = has(b, ul) ? axis_value(b, ax.u) : 0.0, dv = has(b, vl) ? axis_value(b, ax.v) : 0.0;
+    for (int rep = 0; rep < repeats; ++rep) {
+      if (absolute_) {
+        if (has(b, ul)) hu = du;
+        if (has(b, vl)) hv = dv;
+      } else {
+        hu += du, hv += dv;
+      }
+      drill_hole(ax, hu, hv, old_w, r, bottom, f);
+      old_w = clear;
+      b_.rapid(line_, cycle_point(ax, hu, hv, clear));
+    }
+  }
+
+  void cycle_words(Block& b, const std::string& g, char wl) {
     for (char L : {'A', 'B', 'C'})
       if (has(b, L)) fail("canned cycle '" + g + "' with rotary axis word '" + text(b, L) + "'");
     CycleSticky& cs = cycle_sticky_;
     if (has(b, 'R')) cs.r = len(b, 'R'), cs.has_r = true;
-    if (has(b, 'Z')) cs.z = len(b, 'Z'), cs.has_z = true;
-    b.used[idx('Z')] = true;
+    if (has(b, wl)) cs.z = len(b, wl), cs.has_z = true;
+    b.used[idx(wl)] = true;
     if (has(b, 'Q')) {
       cs.q = len(b, 'Q');
       cs.has_q = true;
@@ -1012,76 +1057,45 @@ class Interpreter {
       cs.has_p = true;
       if (motion_ != 820) fail("unused word '" + text(b, 'P') + "' (" + g + " takes no P)");
     }
-    if (!cs.has_r || !cs.has_z) fail("canned cycle '" + g + "' needs R and Z");
+    if (!cs.has_r || !cs.has_z) fail("canned cycle '" + g + "' needs R and " + wl);
     if ((motion_ == 830 || motion_ == 730) && (!cs.has_q || cs.q <= 0.0)) fail("'" + g + "' needs Q > 0 (peck depth)");
     if (motion_ == 820 && (!cs.has_p || cs.p < 0.0)) fail("'G82' needs P >= 0 (dwell time [s])");
-    const double f = feed_for_move(g, has(b, 'F'));
-    int repeats = 1;
-    if (has(b, 'L')) repeats = integer(b, 'L', 0, static_cast<int>(kMaxRepeats));
+  }
 
-    AxisVector p = b_.position();
-    const double r = absolute_ ? cs.r : p[Z] + cs.r;
-    const double bottom = absolute_ ? cs.z : r + cs.z;
-    if (bottom > r) fail("canned cycle '" + g + "': R (" + fmt(r) + ") is below Z (" + fmt(bottom) + ")");
-    const double q = cs.q;
-    if ((motion_ == 830 || motion_ == 730) && (r - bottom) / q > static_cast<double>(kMaxPecks))
-      fail("'" + g + "': more than " + std::to_string(kMaxPecks) + " pecks");
+  AxisVector cycle_point(const detail::PlaneAxes& ax, double hu, double hv, double w) const {
+    AxisVector v = b_.position();
+    v[ax.u] = hu, v[ax.v] = hv, v[ax.w] = w;
+    return v;
+  }
 
-    // G98 retracts to the initial level: Z before this series of contiguous canned cycle
-    // blocks began (raised to R when it started below R), as LinuxCNC does.
-    if (!cycle_series_) {
-      cycle_series_ = true;
-      cycle_initial_z_ = p[Z];
-      if (p[Z] < r) {
-        p[Z] = r;
-        b_.rapid(line_, p);
-        cycle_initial_z_ = r;
-      }
-    }
-    double old_z = retract_to_initial_ ? std::max(cycle_initial_z_, r) : p[Z];
-    const double clear = retract_to_initial_ ? std::max(cycle_initial_z_, r) : r;
-    double x = p[X], y = p[Y];
-    const double dx = has(b, 'X') ? axis_value(b, X) : 0.0;
-    const double dy = has(b, 'Y') ? axis_value(b, Y) : 0.0;
-    auto at = [&](double z) {
-      AxisVector v = b_.position();
-      v[X] = x, v[Y] = y, v[Z] = z;
-      return v;
-    };
-    for (int rep = 0; rep < repeats; ++rep) {
-      if (absolute_) {
-        if (has(b, 'X')) x = dx;
-        if (has(b, 'Y')) y = dy;
-      } else {
-        x += dx, y += dy;
-      }
-      b_.rapid(line_, at(old_z));
-      if (old_z != r) b_.rapid(line_, at(r));
-      switch (motion_) {
-        case 810: b_.feed(line_, at(bottom), f, inverse_time_); break;
-        case 820:
-          b_.feed(line_, at(bottom), f, inverse_time_);
-          b_.dwell(line_, cs.p);
-          break;
-        case 830:
-          for (double d = r - q; d > bottom; d -= q) {
-            b_.feed(line_, at(d), f, inverse_time_);
-            b_.rapid(line_, at(r));
-            b_.rapid(line_, at(d + kG83RapidDelta));
-          }
-          b_.feed(line_, at(bottom), f, inverse_time_);
-          break;
-        case 730:
-          for (double d = r - q; d > bottom; d -= q) {
-            b_.feed(line_, at(d), f, inverse_time_);
-            b_.rapid(line_, at(d + kG73Retract));
-          }
-          b_.feed(line_, at(bottom), f, inverse_time_);
-          break;
-        default: break;
-      }
-      b_.rapid(line_, at(clear));
-      old_z = clear;
+  // One hole at (hu, hv): rapid over it at old_w, down to R, then the cycle's feed moves.
+  void drill_hole(const detail::PlaneAxes& ax, double hu, double hv, double old_w, double r, double bottom, double f) {
+    auto at = [&](double w) { return cycle_point(ax, hu, hv, w); };
+    const double q = cycle_sticky_.q;
+    b_.rapid(line_, at(old_w));
+    if (old_w != r) b_.rapid(line_, at(r));
+    switch (motion_) {
+      case 810: b_.feed(line_, at(bottom), f, inverse_time_); break;
+      case 820:
+        b_.feed(line_, at(bottom), f, inverse_time_);
+        b_.dwell(line_, cycle_sticky_.p);
+        break;
+      case 830:
+        for (double d = r - q; d > bottom; d -= q) {
+          b_.feed(line_, at(d), f, inverse_time_);
+          b_.rapid(line_, at(r));
+          b_.rapid(line_, at(d + kG83RapidDelta));
+        }
+        b_.feed(line_, at(bottom), f, inverse_time_);
+        break;
+      case 730:
+        for (double d = r - q; d > bottom; d -= q) {
+          b_.feed(line_, at(d), f, inverse_time_);
+          b_.rapid(line_, at(d + kG73Retract));
+        }
+        b_.feed(line_, at(bottom), f, inverse_time_);
+        break;
+      default: break;
     }
   }
 
@@ -1107,7 +1121,7 @@ class Interpreter {
   bool ended_ = false;
   int wcs_ = 0;
   double scale_ = 1.0;  // mm per program length unit
-  bool absolute_ = true, arc_absolute_ = false, inverse_time_ = false, retract_to_initial_ = true;
+  bool absolute_ = true, arc_absolute_ = false, inverse_time_ = false, retract_to_initial_ = false;  // G99 at start, as LinuxCNC's interpreter
   bool per_rev_ = false;        // G95: F is [length unit / revolution]
   bool css_ = false;            // G96 constant surface speed (else G97 rpm)
   double css_max_rpm_ = 0.0;    // G96 D [rpm]; 0: none
