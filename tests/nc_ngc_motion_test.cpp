@@ -181,7 +181,40 @@ TEST(NgcCannedCycles, DrillAlongTheThirdAxisOfEveryPlane) {
   const std::string dflt = "G21 G90 F100\nG0 X5 Y10 Z10\nG81 X1 Y1 Z-1 R2\nX2\nM2\n";
   EXPECT_DOUBLE_EQ(ends(run(dflt))[4][Z], 2.0);
   cross_check(dflt, {});
+  // Regression: a G99 block raised above the initial level, then G98 (retracts to the
+  // initial level, starts from the current height); a G98 block after G99 starts from the
+  // initial level (a diagonal traverse), as rs274.
+  cross_check_path("G21 G90 G17\nG0 X0 Y0 Z10\nG98 G81 X5 Y5 Z-3 R2 F100\nX10\nG99 G83 X20 Z-11 R1 Q2.5\n"
+                   "G98 G73 X30 Y10 Z-7 R2 Q2\nG82 X40 Z-4 R2 P0.2\nG99 G81 X50 R12 Z-1\nG98 X60 R2\nM2\n",
+                   {});
   cross_check("G21 G90 F100\nG0 X5 Y10 Z5\nG18 G91 G73 X2 Z1 Y-6 R-2 Q1.5 L3\nG90 G80\nG19 G82 Y1 Z2 X1 R4 P0.5\nM2\n", {});
+}
+
+// ---- polar coordinates (@ distance, ^ angle) -------------------------------------------------
+
+TEST(NgcPolar, AbsoluteIncrementalAndInCannedCycles) {
+  // G90: @ and ^ from the XY origin; G91: added to the current distance and angle.
+  const std::string prog = "G21 G90 F100\nG0 @10 ^30\nG91 G1 @5 ^60\nG90 G1 ^180\nM2\n";
+  const auto e = ends(run(prog));
+  ASSERT_EQ(e.size(), 3u);
+  EXPECT_NEAR(e[0][X], 10.0 * std::cos(std::numbers::pi / 6), 1e-12);
+  EXPECT_NEAR(e[0][Y], 5.0, 1e-12);
+  EXPECT_NEAR(e[1][X], 0.0, 1e-12);  // distance 15 at 90 deg
+  EXPECT_NEAR(e[1][Y], 15.0, 1e-12);
+  EXPECT_NEAR(e[2][X], -15.0, 1e-12);
+  cross_check(prog, {});
+  // A bolt circle: six holes 60 deg apart from X15 Y0 (LinuxCNC's hole-circle.ngc), and the
+  // regression for G91 R in a continued series (relative to where the series began).
+  const std::string holes = "G21 G90 F100\nG0 X15 Y0 Z0\nG91 G81 R2 Z-5 ^60 L6\nG90 G0 Z10\nG81 @5 ^33 R2 Z-3\n"
+                            "G91 @5 R1 Z-3 L2\nG90 G80\nM2\n";
+  const auto h = ends(run(holes));
+  ASSERT_GE(h.size(), 5u);
+  EXPECT_NEAR(h[2][X], 15.0 * std::cos(std::numbers::pi / 3), 1e-12);  // first hole at 60 deg
+  EXPECT_NEAR(h[2][Y], 15.0 * std::sin(std::numbers::pi / 3), 1e-12);
+  EXPECT_NEAR(h[3][Z], -3.0, 1e-12);  // R = 0 + 2, bottom R - 5
+  cross_check_path(holes, {});
+  EXPECT_EQ(error_of("G0 @1 X2\n"), "t.ngc:1: polar coordinates '@1' cannot be combined with X or Y words");
+  EXPECT_EQ(error_of("G91 G0 ^10\n"), "t.ngc:1: incremental polar coordinates '^10' are indeterminate at the origin");
 }
 
 // ---- cutter radius compensation -------------------------------------------------------------

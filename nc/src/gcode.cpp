@@ -64,8 +64,12 @@ struct Block {
   std::array<double, 26> val{};
   std::array<std::string, 26> text;
   std::array<bool, 26> used{};
+  // Polar coordinates: @ distance, ^ angle [deg] from the XY origin (LinuxCNC).
+  bool has_at = false, has_caret = false, used_polar = false;
+  double at = 0.0, caret = 0.0;
+  std::string polar_text;  // "@..." and/or "^..." as written
   bool empty() const {
-    if (!g.empty() || !m.empty()) return false;
+    if (!g.empty() || !m.empty() || has_at || has_caret) return false;
     for (bool h : has)
       if (h) return false;
     return true;
@@ -215,7 +219,8 @@ class Interpreter {
         pending_.push_back(expr_.assignment(s, i));
         continue;
       }
-      if (!std::isalpha(static_cast<unsigned char>(c))) fail("unexpected character '" + printable(c) + "'");
+      if (!std::isalpha(static_cast<unsigned char>(c)) && c != '@' && c != '^')
+        fail("unexpected character '" + printable(c) + "'");
       const char L = c;
       ++i;
       if (L == 'O') fail("O-word '" + s.substr(i - 1) + "' must begin the line");
@@ -245,6 +250,14 @@ class Interpreter {
         blk.has[k] = true;
         blk.val[k] = w.value;
         blk.text[k] = w.text;
+        break;
+      }
+      case '@': case '^': {
+        bool& h = L == '@' ? blk.has_at : blk.has_caret;
+        if (h) fail("word '" + std::string(1, L) + "' given twice");
+        h = true;
+        (L == '@' ? blk.at : blk.caret) = w.value;
+        blk.polar_text += (blk.polar_text.empty() ? "" : " ") + w.text;
         break;
       }
       case 'U': case 'V': case 'W': fail("unsupported word '" + w.text + "' (axes U, V, W are not supported)");
@@ -294,6 +307,7 @@ class Interpreter {
     return kNames[(opt_.rotary[0] ? 1 : 0) + (opt_.rotary[1] ? 2 : 0) + (opt_.rotary[2] ? 4 : 0)];
   }
   bool any_axis(const Block& b) const {
+    if (b.has_at || b.has_caret) return true;
     for (char L : kAxisLetters)
       if (has(b, L)) return true;
     return false;
@@ -308,6 +322,7 @@ class Interpreter {
   }
   // End point of a move: program coordinates.
   AxisVector target(Block& b, bool machine_coords) {
+    if ((b.has_at || b.has_caret) && machine_coords) fail("polar coordinates '" + b.polar_text + "' cannot be used with G53");
     if (machine_coords) {
       AxisVector m = b_.to_machine(b_.position());
       for (int a = 0; a < kAxes; ++a)
@@ -320,7 +335,31 @@ class Interpreter {
       const double v = axis_value(b, a);
       t[a] = absolute_ ? v : t[a] + v;
     }
+    if (b.has_at || b.has_caret) {
+      const auto xy = polar_xy(b, t[X], t[Y]);
+      t[X] = xy[0], t[Y] = xy[1];
+    }
     return t;
+  }
+
+  // X Y of polar words from the point (x, y), as LinuxCNC: in G90 @ is the distance from the
+  // XY origin and ^ the angle from +X, counter-clockwise [deg] (a missing one keeps the
+  // point's); in G91 both are added to the point's distance and angle.
+  std::array<double, 2> polar_xy(Block& b, double x, double y) {
+    if (has(b, 'X') || has(b, 'Y')) fail("polar coordinates '" + b.polar_text + "' cannot be combined with X or Y words");
+    if (!axis_allowed(Y)) fail("polar coordinates '" + b.polar_text + "' need axes X and Y (machine kind " + machine_name() + ")");
+    b.used_polar = true;
+    double r = std::hypot(x, y), a = std::atan2(y, x);
+    constexpr double kRad = std::numbers::pi / 180.0;
+    if (absolute_) {
+      if (b.has_at) r = b.at * scale_;
+      if (b.has_caret) a = b.caret * kRad;
+    } else {
+      if (x == 0.0 && y == 0.0) fail("incremental polar coordinates '" + b.polar_text + "' are indeterminate at the origin");
+      r += b.has_at ? b.at * scale_ : 0.0;
+      a += b.has_caret ? b.caret * kRad : 0.0;
+    }
+    return {r * std::cos(a), r * std::sin(a)};
   }
 
   // ---- execution -------------------------------------------------------------------------
@@ -662,6 +701,8 @@ class Interpreter {
       fail("unused word '" + text(b, 'D') + "' (D is a tool number for G41/G42, a diameter for G41.1/G42.1, or the maximum speed for G96)");
     for (int k = 0; k < 26; ++k)
       if (b.has[k] && !b.used[k]) fail("unused word '" + b.text[k] + "' (no G-code in the block uses it)");
+    if ((b.has_at || b.has_caret) && !b.used_polar)
+      fail("unused polar coordinates '" + b.polar_text + "' (no motion in the block uses them)");
   }
   // ---- spindle-synchronised motion (G33, G33.1, G76) --------------------------------------
   // The tool path carries no spindle angle: a synchronised move is a feed move at
@@ -1006,29 +1047,33 @@ class Interpreter {
     int repeats = 1;
     if (has(b, 'L')) repeats = integer(b, 'L', 0, static_cast<int>(kMaxRepeats));
     AxisVector p = pos();
-    const double r = absolute_ ? cs.r : p[ax.w] + cs.r;
+    // The initial level: the hole-axis position where this series of contiguous canned cycle
+    // blocks began. In G91 R is relative to it; G98 retracts to it (or R, the higher), and a
+    // G98 block starts from it (or the current position, the higher). A block that starts
+    // below R first rises to R where it stands. All as LinuxCNC (checked against rs274).
+    if (!cycle_series_) cycle_initial_z_ = p[ax.w];
+    cycle_series_ = true;
+    const double r = absolute_ ? cs.r : cycle_initial_z_ + cs.r;
     const double bottom = absolute_ ? cs.z : r + cs.z;
     if (bottom > r) fail("canned cycle '" + g + "': R (" + fmt(r) + ") is below " + wl + " (" + fmt(bottom) + ")");
     if ((motion_ == 830 || motion_ == 730) && (r - bottom) / cs.q > static_cast<double>(kMaxPecks))
       fail("'" + g + "': more than " + std::to_string(kMaxPecks) + " pecks");
-    // G98 retracts to the initial level: the hole-axis position before this series of
-    // contiguous canned cycle blocks began (raised to R when it started below R), as LinuxCNC.
-    if (!cycle_series_) {
-      cycle_series_ = true;
-      cycle_initial_z_ = p[ax.w];
-      if (p[ax.w] < r) {
-        p[ax.w] = r;
-        b_.rapid(line_, p);
-        cycle_initial_z_ = r;
-      }
+    double old_w = retract_to_initial_ ? std::max(cycle_initial_z_, p[ax.w]) : p[ax.w];
+    if (old_w < r) {
+      p[ax.w] = r;
+      b_.rapid(line_, p);
+      old_w = r;
     }
-    double old_w = retract_to_initial_ ? std::max(cycle_initial_z_, r) : p[ax.w];
     const double clear = retract_to_initial_ ? std::max(cycle_initial_z_, r) : r;
     double hu = p[ax.u], hv = p[ax.v];
     const char ul = kAxisLetters[ax.u], vl = kAxisLetters[ax.v];
     const double du = has(b, ul) ? axis_value(b, ax.u) : 0.0, dv = has(b, vl) ? axis_value(b, ax.v) : 0.0;
     for (int rep = 0; rep < repeats; ++rep) {
-      if (absolute_) {
+      if (b.has_at || b.has_caret) {
+        if (plane_ != Plane::XY) fail("polar coordinates '" + b.polar_text + "' in a canned cycle need plane G17");
+        const auto xy = polar_xy(b, hu, hv);
+        hu = xy[0], hv = xy[1];
+      } else if (absolute_) {
         if (has(b, ul)) hu = du;
         if (has(b, vl)) hv = dv;
       } else {
@@ -1139,7 +1184,7 @@ class Interpreter {
   int pauses_ = 0;
   CycleSticky cycle_sticky_;
   bool cycle_series_ = false;     // inside a series of contiguous canned cycle blocks
-  double cycle_initial_z_ = 0.0;  // program Z when the series began
+  double cycle_initial_z_ = 0.0;  // hole-axis position when the series began
 };
 
 }  // namespace
