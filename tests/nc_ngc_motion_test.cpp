@@ -217,6 +217,25 @@ TEST(NgcPolar, AbsoluteIncrementalAndInCannedCycles) {
   EXPECT_EQ(error_of("G91 G0 ^10\n"), "t.ngc:1: incremental polar coordinates '^10' are indeterminate at the origin");
 }
 
+// ---- M70-M73 modal state ---------------------------------------------------------------------
+
+TEST(NgcModalState, SaveRestoreAndAutoRestoreOnReturn) {
+  // M70/M72 at one level; M73 in a subroutine restores the caller's G21 G90 F100 at endsub.
+  const std::string prog = "G21 G90 F200\nM70\nG20 G91 F5\nG1 X1\nM72\nG1 X10\n"
+                           "o<s> sub\nM73\nG20 G91 F5\nG1 X1\no<s> endsub\nG21 G90 F100\no<s> call\nG1 X50\nM71\nM2\n";
+  const Toolpath tp = run(prog);
+  ASSERT_EQ(tp.segments.size(), 4u);
+  EXPECT_DOUBLE_EQ(tp.segments[0].end[X], 25.4);
+  EXPECT_DOUBLE_EQ(tp.segments[0].feed_mm_per_min, 127.0);
+  EXPECT_DOUBLE_EQ(tp.segments[1].end[X], 10.0);  // G21 G90 again
+  EXPECT_DOUBLE_EQ(tp.segments[1].feed_mm_per_min, 200.0);
+  EXPECT_DOUBLE_EQ(tp.segments[2].end[X], 10.0 + 25.4);
+  EXPECT_DOUBLE_EQ(tp.segments[3].end[X], 50.0);
+  EXPECT_DOUBLE_EQ(tp.segments[3].feed_mm_per_min, 100.0);
+  cross_check(prog, {});
+  EXPECT_EQ(error_of("M70\nM71\nM72\n"), "t.ngc:3: 'M72': no modal state saved at this call level (M70 or M73 first)");
+}
+
 // ---- cutter radius compensation -------------------------------------------------------------
 
 // The last end point of the segments of `line`.

@@ -95,6 +95,7 @@ class Interpreter {
     selected_tool_ = o.start_tool;
     params_.numbered_hook = [this](int n, double& v) { return system_numbered(n, v); };
     params_.named_hook = [this](const std::string& n, double& v) { return system_named(n, v); };
+    flow_.on_leave([this](int level) { leave_level(level); });
   }
 
   Toolpath run(const std::string& text) {
@@ -414,6 +415,7 @@ class Interpreter {
     const Word* mcool = nullptr;
     const Word* m61 = nullptr;
     const Word* mio = nullptr;  // overrides, digital outputs: nothing to simulate
+    const Word* mstate = nullptr;  // M70-M73: modal state save/restore
     bool f_in_block = false;
   };
 
@@ -432,6 +434,7 @@ class Interpreter {
       else b_.dwell(line_, p);
     }
     set_modes(b, k);
+    if (k.mstate != nullptr) modal_state(*k.mstate);
     // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing).
     for (int a = 0; a < kAxes; ++a)
       if (has(b, kAxisLetters[a]) && !axis_allowed(a) && k.g10 == 0)
@@ -489,6 +492,7 @@ class Interpreter {
       case 6: return &k.m6;
       case 7: case 8: case 9: return &k.mcool;
       case 61: return &k.m61;
+      case 70: case 71: case 72: case 73: return &k.mstate;
       case 48: case 49: case 50: case 51: case 52: case 53: case 62: case 63: case 64: case 65: return &k.mio;
       default: break;
     }
@@ -573,6 +577,55 @@ class Interpreter {
     if (k.g[kDistance]) absolute_ = code10(*k.g[kDistance]) == 900;
     if (k.g[kArcDistance]) arc_absolute_ = code10(*k.g[kArcDistance]) == 901;
     if (k.g[kRetract]) retract_to_initial_ = code10(*k.g[kRetract]) == 980;
+  }
+
+  // ---- M70-M73: modal state save/restore, per call level, as LinuxCNC ----------------------
+  // Saved: units, plane, distance modes, feed mode, F, S and its mode, spindle, coolant, lathe
+  // diameter mode, path control, retract mode, the active work offset.
+  struct ModalState {
+    double scale = 1.0, feed = 0.0, rpm = 0.0, css_max = 0.0, path_tol = 0.0, path_q_tol = 0.0;
+    bool absolute = true, arc_absolute = false, inverse = false, per_rev = false, css = false, diameter = false,
+         retract_initial = false, auto_restore = false;
+    int path_mode = 640, spindle = 5, coolant = 9, wcs = 0;
+    Plane plane = Plane::XY;
+  };
+
+  void modal_state(const Word& w) {
+    const int c = static_cast<int>(w.value);
+    const int level = flow_.call_level();
+    if (c == 70 || c == 73) {
+      ModalState m{scale_, feed_, spindle_rpm_, css_max_rpm_, path_tol_mm_, path_q_tol_mm_, absolute_, arc_absolute_,
+                   inverse_time_, per_rev_, css_, diameter_mode_, retract_to_initial_, c == 73, path_mode_, spindle_,
+                   coolant_, wcs_, plane_};
+      saved_states_[level] = m;
+      return;
+    }
+    const auto it = saved_states_.find(level);
+    if (it == saved_states_.end()) fail("'" + w.text + "': no modal state saved at this call level (M70 or M73 first)");
+    if (c == 71) {
+      saved_states_.erase(it);
+      return;
+    }
+    restore(it->second);
+  }
+
+  void restore(const ModalState& m) {
+    if (comp_.active() && (m.plane != plane_ || m.scale != scale_ || m.wcs != wcs_))
+      fail("cannot restore the modal state (plane, units, work offset) with cutter radius compensation on (G40 first)");
+    scale_ = m.scale, feed_ = m.feed, spindle_rpm_ = m.rpm, css_max_rpm_ = m.css_max;
+    path_tol_mm_ = m.path_tol, path_q_tol_mm_ = m.path_q_tol, absolute_ = m.absolute, arc_absolute_ = m.arc_absolute;
+    inverse_time_ = m.inverse, per_rev_ = m.per_rev, css_ = m.css, diameter_mode_ = m.diameter;
+    retract_to_initial_ = m.retract_initial, path_mode_ = m.path_mode, spindle_ = m.spindle, coolant_ = m.coolant;
+    plane_ = m.plane;
+    if (m.wcs != wcs_) select_wcs(m.wcs);
+  }
+
+  // A subroutine returns: M73 state saved in it is restored; its saved states end with it.
+  void leave_level(int level) {
+    const auto it = saved_states_.find(level);
+    if (it == saved_states_.end()) return;
+    if (it->second.auto_restore) restore(it->second);
+    saved_states_.erase(it);
   }
 
   // G40 (off), G41/G42 [D tool number] (left/right by the radius of tool D, default: the
@@ -1157,6 +1210,7 @@ class Interpreter {
   detail::ControlFlow flow_;
   detail::CutterComp comp_{b_, [this](const std::string& m) { fail(m); }};
   bool arc_after_g40_ = false;  // the move after G40 must be straight (LinuxCNC)
+  std::map<int, ModalState> saved_states_;  // M70/M73, per call level
   std::vector<detail::ParamAssign> pending_;
   std::array<AxisVector, 9> offsets_;
   AxisVector g28_, g30_;

@@ -371,6 +371,7 @@ void ControlFlow::leave(const OWord& o) {
     value = expr_.bracketed(code, p);
     if (p != code.size()) fail("unexpected '" + code.substr(p) + "' after " + owtext(o));
   }
+  if (on_leave_) on_leave_(call_level());
   params_.pop_frame();
   stack_.pop_back();
   stack_.back().pc += 1;
