@@ -287,6 +287,10 @@ TEST(NgcCutterComp, ArcsInXYAndXZAndTheDiameterForm) {
   const std::string xz = "G21 G90 G18 F300\nG0 X-5 Z-5 Y0\nG42 D2\nG1 X0 Z0\nG1 Z25\nG2 R6.25 X-6.25 Z31.25\n"
                          "G1 X-12.5\nG3 R6.25 X-18.75 Z37.5\nG1 Z43.75\nG40\nM2\n";
   cross_check_path(xz, mill_with_tools());
+  std::string xz_left = xz;
+  xz_left.replace(xz_left.find("G42"), 3, "G41");
+  xz_left.replace(xz_left.find("G0 X-5 Z-5"), 10, "G0 X5 Z-5");
+  cross_check_path(xz_left, mill_with_tools());
   // G41.1 D4 (diameter in the block) gives the path of G41 D2 (tool 2: 4 mm).
   std::string d = xy;
   for (std::size_t at; (at = d.find("D2")) != std::string::npos;) d.replace(at, 2, "D4");

@@ -40,7 +40,7 @@ void CutterComp::on(int side, double radius_mm, Plane p) {
   if (side_ != 0) fail("cannot turn cutter radius compensation on when it is already on");
   if (p == Plane::YZ) fail("cutter radius compensation needs plane G17 (XY) or G18 (XZ)");
   side_ = side;
-  r_ = radius_mm;
+  radius_mm_ = radius_mm;
   plane_ = p;
   ax_ = plane_axes(p);
   first_ = true;
@@ -49,7 +49,7 @@ void CutterComp::on(int side, double radius_mm, Plane p) {
 }
 
 bool CutterComp::off() {
-  const bool was_open = side_ != 0 && r_ > 0.0 && !first_;
+  const bool was_open = side_ != 0 && radius_mm_ > 0.0 && !first_;
   if (was_open) {
     flush(cur_[ax_.u], cur_[ax_.v]);
     b_.set_position(prog_);
@@ -60,7 +60,7 @@ bool CutterComp::off() {
 }
 
 void CutterComp::line(int line, bool rapid, const AxisVector& end, double feed, bool inverse_time) {
-  if (r_ <= 0.0) {
+  if (radius_mm_ <= 0.0) {
     if (rapid) b_.rapid(line, end);
     else b_.feed(line, end, feed, inverse_time);
     prog_ = cur_ = end;
@@ -82,7 +82,7 @@ void CutterComp::line(int line, bool rapid, const AxisVector& end, double feed, 
     return;
   }
   const double nd = std::atan2(dv, du), n = nd + side_ * 0.5 * kPi;
-  it.end[u] += r_ * std::cos(n), it.end[v] += r_ * std::sin(n);
+  it.end[u] += radius_mm_ * std::cos(n), it.end[v] += radius_mm_ * std::sin(n);
   it.du = std::cos(nd), it.dv = std::sin(nd), it.xy = true;
   const Corner k = corner(nd);
   if (k.turn > kCornerTol) {
@@ -92,7 +92,7 @@ void CutterComp::line(int line, bool rapid, const AxisVector& end, double feed, 
     flush(cur_[u], cur_[v]);
     if (k.turn < -kCornerTol) {
       AxisVector mid = b_.position();
-      mid[u] = prog_[u] + r_ * std::cos(n), mid[v] = prog_[v] + r_ * std::sin(n);
+      mid[u] = prog_[u] + radius_mm_ * std::cos(n), mid[v] = prog_[v] + radius_mm_ * std::sin(n);
       corner_arc(line, rapid, mid, feed, inverse_time);
     }
   }
@@ -102,7 +102,7 @@ void CutterComp::line(int line, bool rapid, const AxisVector& end, double feed, 
 
 void CutterComp::arc(int line, const AxisVector& end, double cu, double cv, int rotation, double feed,
                      bool inverse_time) {
-  if (r_ <= 0.0) {
+  if (radius_mm_ <= 0.0) {
     b_.arc(line, plane_, end, cu, cv, rotation, feed, inverse_time);
     prog_ = cur_ = end;
     return;
@@ -110,20 +110,20 @@ void CutterComp::arc(int line, const AxisVector& end, double cu, double cv, int 
   const int u = ax_.u, v = ax_.v;
   const bool inside = side_ * rotation > 0;  // G41 with G3, G42 with G2: the tool is inside the arc
   const double re = std::hypot(end[u] - cu, end[v] - cv);
-  if (inside && re <= r_)
-    fail("the tool radius (" + mm(r_) + ") is not less than the arc radius (" + mm(re) + ") with cutter compensation");
+  if (inside && re <= radius_mm_)
+    fail("the tool radius (" + mm(radius_mm_) + ") is not less than the arc radius (" + mm(re) + ") with cutter compensation");
   if (first_) return entry_arc(line, end, cu, cv, rotation, feed, inverse_time);
   Item it;
   it.kind = Kind::Arc;
   it.line = line;
   it.end = end;
-  const double off_r = inside ? -r_ : r_;
+  const double off_r = inside ? -radius_mm_ : radius_mm_;
   it.end[u] += off_r * (end[u] - cu) / re, it.end[v] += off_r * (end[v] - cv) / re;
   it.feed = feed, it.inverse = inverse_time, it.cu = cu, it.cv = cv, it.rotation = rotation, it.xy = true;
   const double a0 = std::atan2(prog_[v] - cv, prog_[u] - cu);
   const double nd = a0 + (rotation > 0 ? 0.5 : -0.5) * kPi, n = nd + side_ * 0.5 * kPi;
   AxisVector mid = cur_;
-  mid[u] = prog_[u] + r_ * std::cos(n), mid[v] = prog_[v] + r_ * std::sin(n);
+  mid[u] = prog_[u] + radius_mm_ * std::cos(n), mid[v] = prog_[v] + radius_mm_ * std::sin(n);
   const Corner k = corner(nd);
   if (k.turn > kCornerTol) {
     const auto q = meet(0.0, 0.0, 0.0, cu, cv, std::hypot(mid[u] - cu, mid[v] - cv));
@@ -151,15 +151,15 @@ void CutterComp::dwell(int line, double seconds) {
 void CutterComp::entry_line(int line, bool rapid, const AxisVector& end, double feed, bool inverse) {
   const int u = ax_.u, v = ax_.v;
   const double d = std::hypot(end[u] - cur_[u], end[v] - cur_[v]);
-  if (d <= r_)
-    fail("the cutter compensation entry move (" + mm(d) + " in the plane) is not longer than the tool radius (" + mm(r_) +
+  if (d <= radius_mm_)
+    fail("the cutter compensation entry move (" + mm(d) + " in the plane) is not longer than the tool radius (" + mm(radius_mm_) +
          ")");
   const double n = std::atan2(end[v] - cur_[v], end[u] - cur_[u]) + side_ * 0.5 * kPi;
   Item it;
   it.kind = rapid ? Kind::Rapid : Kind::Feed;
   it.line = line;
   it.end = end;
-  it.end[u] += r_ * std::cos(n), it.end[v] += r_ * std::sin(n);
+  it.end[u] += radius_mm_ * std::cos(n), it.end[v] += radius_mm_ * std::sin(n);
   it.feed = feed, it.inverse = inverse, it.xy = true;
   push(it);
   prog_ = end;
@@ -174,7 +174,7 @@ void CutterComp::entry_arc(int line, const AxisVector& end, double cu, double cv
   const int u = ax_.u, v = ax_.v;
   const double re = std::hypot(end[u] - cu, end[v] - cv);
   const double wu = (end[u] - cu) / re, wv = (end[v] - cv) / re;  // radius through the end point
-  const double off_r = side_ * rotation > 0 ? -r_ : r_;
+  const double off_r = side_ * rotation > 0 ? -radius_mm_ : radius_mm_;
   Item it;
   it.kind = Kind::Arc;
   it.line = line;
@@ -211,7 +211,7 @@ std::array<double, 2> CutterComp::meet(double pu, double pv, double nd, double c
   const bool prev_arc = prev != nullptr && prev->kind == Kind::Arc;
   const char* what = prev_arc ? (rc > 0.0 ? "arc to arc" : "arc to straight") : (rc > 0.0 ? "straight to arc" : "straight to straight");
   auto no_room = [&] {
-    fail(std::string(what) + " motion makes a corner the compensated tool (radius " + mm(r_) +
+    fail(std::string(what) + " motion makes a corner the compensated tool (radius " + mm(radius_mm_) +
          ") cannot fit in without gouging");
   };
   // Points of the open move's path: line e + t (e - s) or circle around the open arc's centre.
@@ -277,13 +277,13 @@ void CutterComp::flush(double u, double v) {
     if (it.kind == Kind::Rapid || it.kind == Kind::Feed) {
       if ((u - su) * it.du + (v - sv) * it.dv < 0.0)
         fail(std::string(it.kind == Kind::Rapid ? "straight traverse" : "straight feed") +
-             " in a concave corner cannot be reached by the tool (radius " + mm(r_) + ") without gouging");
+             " in a concave corner cannot be reached by the tool (radius " + mm(radius_mm_) + ") without gouging");
     } else if (it.kind == Kind::Arc) {
       const double a0 = std::atan2(sv - it.cv, su - it.cu);
       double old_sweep = sweep(a0, std::atan2(it.end[iv] - it.cv, it.end[iu] - it.cu), it.rotation);
       if (old_sweep < 1e-12) old_sweep = 2.0 * kPi;  // a full circle
       if (sweep(a0, std::atan2(v - it.cv, u - it.cu), it.rotation) > old_sweep + 1e-9)
-        fail("arc move in a concave corner cannot be reached by the tool (radius " + mm(r_) + ") without gouging");
+        fail("arc move in a concave corner cannot be reached by the tool (radius " + mm(radius_mm_) + ") without gouging");
     }
     if (it.kind != Kind::Dwell) it.end[iu] = u, it.end[iv] = v;
   }

@@ -74,7 +74,7 @@ class CutterComp {
   PathBuilder& b_;
   Fail fail_;
   int side_ = 0;
-  double r_ = 0.0;
+  double radius_mm_ = 0.0;
   Plane plane_ = Plane::XY;
   PlaneAxes ax_{X, Y, Z};
   bool first_ = true;
