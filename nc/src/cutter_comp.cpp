@@ -84,13 +84,13 @@ void CutterComp::line(int line, bool rapid, const AxisVector& end, double feed, 
   const double nd = std::atan2(dv, du), n = nd + side_ * 0.5 * kPi;
   it.end[u] += radius_mm_ * std::cos(n), it.end[v] += radius_mm_ * std::sin(n);
   it.du = std::cos(nd), it.dv = std::sin(nd), it.xy = true;
-  const Corner k = corner(nd);
-  if (k.turn > kCornerTol) {
+  const Corner k = corner(nd, false);
+  if (k.concave) {
     const auto q = meet(it.end[u], it.end[v], nd, 0.0, 0.0, 0.0);
     flush(q[0], q[1]);
   } else {
     flush(cur_[u], cur_[v]);
-    if (k.turn < -kCornerTol) {
+    if (k.convex) {
       AxisVector mid = b_.position();
       mid[u] = prog_[u] + radius_mm_ * std::cos(n), mid[v] = prog_[v] + radius_mm_ * std::sin(n);
       corner_arc(line, rapid, mid, feed, inverse_time);
@@ -124,13 +124,13 @@ void CutterComp::arc(int line, const AxisVector& end, double cu, double cv, int 
   const double nd = a0 + (rotation > 0 ? 0.5 : -0.5) * kPi, n = nd + side_ * 0.5 * kPi;
   AxisVector mid = cur_;
   mid[u] = prog_[u] + radius_mm_ * std::cos(n), mid[v] = prog_[v] + radius_mm_ * std::sin(n);
-  const Corner k = corner(nd);
-  if (k.turn > kCornerTol) {
+  const Corner k = corner(nd, !inside);
+  if (k.concave) {
     const auto q = meet(0.0, 0.0, 0.0, cu, cv, std::hypot(mid[u] - cu, mid[v] - cv));
     flush(q[0], q[1]);
   } else {
     flush(cur_[u], cur_[v]);
-    if (k.turn < -kCornerTol) corner_arc(line, false, mid, feed, inverse_time);
+    if (k.convex) corner_arc(line, false, mid, feed, inverse_time);
   }
   push(it);
   prog_ = end;
@@ -191,11 +191,24 @@ void CutterComp::entry_arc(int line, const AxisVector& end, double cu, double cv
   first_ = false;
 }
 
-// How the path turns at the programmed corner prog_: the open move's direction there follows
-// from its offset end point cur_ (it lies on the tool side, square to the direction).
-CutterComp::Corner CutterComp::corner(double nd) const {
+// How the path turns at the programmed corner prog_, as LinuxCNC classifies it: the open
+// move's direction there follows from its offset end point cur_ (on the tool side, square to
+// the direction); beta is the turn away from the tool side in [-pi/2, 3pi/2). Concave: beta
+// < 0 or > pi (beyond the tolerance), or a reversal after an arc that curves away from the
+// tool (LinuxCNC's "h" shape) or before an arc with the tool outside it (new_arc_outside);
+// convex (corner arc): 0 < beta <= pi. (Both reversal rules found with rs274.)
+CutterComp::Corner CutterComp::corner(double nd, bool new_arc_outside) const {
   const double pd = std::atan2(cur_[ax_.v] - prog_[ax_.v], cur_[ax_.u] - prog_[ax_.u]) - side_ * 0.5 * kPi;
-  return {side_ * norm_angle(nd - pd), nd};
+  double beta = norm_angle(side_ * (pd - nd));
+  if (beta < -0.5 * kPi) beta += 2.0 * kPi;
+  const Item* open = open_move();
+  const bool reversal = beta > kPi - kCornerTol;
+  const bool h_shape = open != nullptr && open->kind == Kind::Arc && side_ * open->rotation < 0;
+  Corner k;
+  k.concave = beta < -kCornerTol || beta > kPi + kCornerTol || (reversal && (h_shape || new_arc_outside));
+  k.convex = !k.concave && beta > kCornerTol;
+  k.nd = nd;
+  return k;
 }
 
 const CutterComp::Item* CutterComp::open_move() const {
@@ -214,18 +227,26 @@ std::array<double, 2> CutterComp::meet(double pu, double pv, double nd, double c
     fail(std::string(what) + " motion makes a corner the compensated tool (radius " + mm(radius_mm_) +
          ") cannot fit in without gouging");
   };
-  // Points of the open move's path: line e + t (e - s) or circle around the open arc's centre.
+  // Of the points where the paths meet, the one the open move reaches last going back from its
+  // end: the smallest angle back along an open arc, the nearest point behind the end of an
+  // open line (a point ahead of it only when there is none behind).
   std::array<double, 2> best{eu, ev};
-  double best_d = INFINITY;
+  double best_cost = INFINITY;
+  const double pdir = std::atan2(ev - prog_[v], eu - prog_[u]) - side_ * 0.5 * kPi;
   auto take = [&](double qu, double qv) {
-    const double d = std::hypot(qu - eu, qv - ev);
-    if (d < best_d) best = {qu, qv}, best_d = d;
+    double cost = 0.0;
+    if (prev_arc) {
+      cost = sweep(std::atan2(qv - prev->cv, qu - prev->cu), std::atan2(ev - prev->cv, eu - prev->cu), prev->rotation);
+    } else {
+      const double t = (qu - eu) * std::cos(pdir) + (qv - ev) * std::sin(pdir);  // < 0: behind the end
+      cost = t <= 1e-9 ? -t : 1e6 + t;
+    }
+    if (cost < best_cost) best = {qu, qv}, best_cost = cost;
   };
   if (!prev_arc) {
     // The open line's programmed direction (square to its offset at the corner): for the
     // entry move that is not the direction from its start, and LinuxCNC uses this one.
-    const double pd = std::atan2(ev - prog_[v], eu - prog_[u]) - side_ * 0.5 * kPi;
-    const double du = std::cos(pd), dv = std::sin(pd);
+    const double du = std::cos(pdir), dv = std::sin(pdir);
     if (rc <= 0.0) {  // line with line p + w (cos nd, sin nd)
       const double wu = std::cos(nd), wv = std::sin(nd), den = du * wv - dv * wu;
       if (std::abs(den) < 1e-12) no_room();

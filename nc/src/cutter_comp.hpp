@@ -54,14 +54,14 @@ class CutterComp {
     bool xy = false;            // moves in the plane (else: along the third axis only, or a dwell)
   };
   struct Corner {
-    double turn = 0.0;  // > 0: towards the tool side (concave)
-    double nd = 0.0;    // direction of the new move at the corner [rad]
+    bool concave = false, convex = false;  // neither: joined as it is
+    double nd = 0.0;                       // direction of the new move at the corner [rad]
   };
 
   [[noreturn]] void fail(const std::string& m) const;
   void entry_line(int line, bool rapid, const AxisVector& end, double feed, bool inverse);
   void entry_arc(int line, const AxisVector& end, double cu, double cv, int rotation, double feed, bool inverse);
-  [[nodiscard]] Corner corner(double nd) const;
+  [[nodiscard]] Corner corner(double nd, bool new_arc_outside) const;
   [[nodiscard]] const Item* open_move() const;
   // The concave corner point where the open move meets the new offset path (line through
   // (pu, pv) with direction nd, or circle around (cu, cv) with radius rc when rc > 0).
