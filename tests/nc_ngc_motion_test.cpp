@@ -302,6 +302,20 @@ TEST(NgcCutterComp, ArcsInXYAndXZAndTheDiameterForm) {
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i][X], b[i][X], 1e-12);
 }
 
+TEST(NgcCutterComp, ReversalsAndFarMeetingPointsAsRs274) {
+  // Regressions from random programs against rs274: a near reversal before an arc with the
+  // tool outside it is a concave corner (the entry line is cut back to the arc); an arc-arc
+  // corner whose offset circles meet far from the programmed corner.
+  cross_check_path("G21 G90 G17 F300\nG0 X-20 Y-20\nG42 D2\nG1 X0 Y0\nG3 X3.729 Y-18.626 R11.344\n"
+                   "G3 X-6.777 Y23.7 R22.663\nG2 X6.878 Y-9.854 R36.558\nG2 X15.207 Y-5.232 R22.247\n"
+                   "G3 X14.683 Y-26.068 R30.179\nG1 X1.205 Y18.254\nG40 G1 X40 Y40\nM2\n",
+                   mill_with_tools());
+  cross_check_path("G21 G90 G17 F300\nG0 X-20 Y-20\nG41 D2\nG1 X0 Y0\nG2 X-4.297 Y-12.663 R20.705\n"
+                   "G1 X25.831 Y-20.893\nG3 X0.934 Y23.007 R37.956\nG2 X18.107 Y-15.502 R28.595\n"
+                   "G3 X10.907 Y6.377 R29.956\nG1 X-5.851 Y-6.427\nG40 G1 X40 Y40\nM2\n",
+                   mill_with_tools());
+}
+
 TEST(NgcCutterComp, ArcEntryHelixAndZMovesInside) {
   // comp311_2-like: the first move after G41 is an arc; Z-only moves between corners.
   GcodeOptions o = mill_with_tools();
