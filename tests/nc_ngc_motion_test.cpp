@@ -340,6 +340,10 @@ TEST(NgcCutterComp, GougingCornersAreRefusedWithTheLine) {
   EXPECT_EQ(error_of("G21 F100\nG41 D1\nG1 X20 Y0\nG40\nG2 X30 Y0 R5\n", mill_with_tools()),
             "t.ngc:5: 'G2': the move just after G40 must be a straight line, not an arc (as LinuxCNC)");
   EXPECT_EQ(error_of("G41 D7\n", mill_with_tools()), "t.ngc:1: 'D7': tool 7 has no diameter in the tool table");
+  // #<_ccomp> follows the state (410 with G41, 400 after G40), as LinuxCNC.
+  const auto cc = ends(run("G21 F100\nG41 D1\nG1 X20 Y0\nG1 X[#<_ccomp>]\nG40\nG1 Y[#<_ccomp>]\n", mill_with_tools()));
+  EXPECT_NEAR(cc[2][X], 410.0, 1e-9);
+  EXPECT_NEAR(cc.back()[Y], 400.0, 1e-9);
   EXPECT_EQ(error_of("G19 G41 D1\n", mill_with_tools()), "t.ngc:1: cutter radius compensation needs plane G17 (XY) or G18 (XZ)");
 }
 

@@ -157,7 +157,7 @@ class Interpreter {
     if (n == "_U" || n == "_V" || n == "_W") return v = 0.0, true;
     const SysParam table[] = {
         {"_VMAJOR", 2.0}, {"_VMINOR", 9.0}, {"_LINE", flow_.line()}, {"_MOTION_MODE", motion_ < 0 ? 800 : motion_},
-        {"_PLANE", plane_ == Plane::XY ? 170 : plane_ == Plane::ZX ? 180 : 190}, {"_CCOMP", 400},
+        {"_PLANE", plane_ == Plane::XY ? 170 : plane_ == Plane::ZX ? 180 : 190}, {"_CCOMP", comp_.active() ? comp_code_ : 400},
         {"_METRIC", scale_ == 1.0}, {"_IMPERIAL", scale_ != 1.0}, {"_ABSOLUTE", absolute_}, {"_INCREMENTAL", !absolute_},
         {"_INVERSE_TIME", inverse_time_}, {"_UNITS_PER_MINUTE", !inverse_time_}, {"_UNITS_PER_REV", 0.0},
         {"_COORD_SYSTEM", wcs_ < 6 ? 540 + 10 * wcs_ : 591 + (wcs_ - 6)}, {"_TOOL_OFFSET", b_.tool_length_offset() != 0.0},
@@ -636,6 +636,7 @@ class Interpreter {
       if (comp_.active()) arc_after_g40_ = comp_.off();
       return;
     }
+    comp_code_ = c;
     if (comp_.active()) fail("'" + w.text + "': cutter radius compensation is already on (G40 first)");
     int side = c == 410 || c == 411 ? 1 : -1;
     double radius = 0.0;
@@ -1211,6 +1212,7 @@ class Interpreter {
   detail::CutterComp comp_{b_, [this](const std::string& m) { fail(m); }};
   bool arc_after_g40_ = false;  // the move after G40 must be straight (LinuxCNC)
   std::map<int, ModalState> saved_states_;  // M70/M73, per call level
+  int comp_code_ = 400;                      // G41/G42/G41.1/G42.1 x 10 while compensation is on
   std::vector<detail::ParamAssign> pending_;
   std::array<AxisVector, 9> offsets_;
   AxisVector g28_, g30_;
