@@ -170,7 +170,7 @@ int main(int argc, char** argv) {
       const double machining = nc::emulated_time_s(w.program, limits);
       std::optional<bench::ReferenceVolume> ref;
       if (w.reference) {
-        ref = bench::reference_removed_volume(w.program, w.prof.tools, w.prof.solid, ref_cell);
+        ref = bench::reference_removed_volume(w.program, w.prof.tooling.tools, w.prof.solid, ref_cell);
         std::printf("%s reference: %.3f mm3 removed (height field, %.3f mm cells, %ld moves, %.1f s)\n", w.name.c_str(),
                     ref->removed_mm3, ref->cell_mm, ref->moves, ref->seconds);
       }

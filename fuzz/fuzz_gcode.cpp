@@ -1,5 +1,6 @@
 // libFuzzer target: the built-in G-code interpreter either returns a Toolpath with finite
-// positions and valid source lines, or throws ParseError naming a line of the input.
+// positions and valid source lines, or throws ParseError naming a line of the input; in both
+// dialects (RS274/NGC and Fanuc).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -11,18 +12,22 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   const long lines = 1 + std::count(text.begin(), text.end(), '\n');
-  lbr::nc::GcodeOptions o;
-  o.tool_lengths = {{1, 60.0}, {2, 50.0}};
-  o.chord_tol_mm = 0.01;
-  try {
-    const lbr::nc::Toolpath tp = lbr::nc::interpret_gcode(text, "fuzz.ngc", o);
-    for (const lbr::nc::Segment& s : tp.segments) {
-      for (double v : s.end)
-        if (!std::isfinite(v)) __builtin_trap();
-      if (s.line < 1 || s.line > lines) __builtin_trap();
+  for (const lbr::nc::Dialect d : {lbr::nc::Dialect::Rs274ngc, lbr::nc::Dialect::Fanuc}) {
+    lbr::nc::GcodeOptions o;
+    o.dialect = d;
+    o.tool_lengths = {{1, 60.0}, {2, 50.0}};
+    o.chord_tol_mm = 0.01;
+    o.max_blocks = 200000;  // an endless loop is refused after this many blocks, not a fuzzer timeout
+    try {
+      const lbr::nc::Toolpath tp = lbr::nc::interpret_gcode(text, "fuzz.ngc", o);
+      for (const lbr::nc::Segment& s : tp.segments) {
+        for (double v : s.end)
+          if (!std::isfinite(v)) __builtin_trap();
+        if (s.line < 1 || s.line > lines) __builtin_trap();
+      }
+    } catch (const lbr::nc::ParseError& e) {
+      if (e.line() < 1 || e.line() > lines) __builtin_trap();
     }
-  } catch (const lbr::nc::ParseError& e) {
-    if (e.line() < 1 || e.line() > lines) __builtin_trap();
   }
   return 0;
 }

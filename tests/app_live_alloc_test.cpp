@@ -131,7 +131,7 @@ class NullSink final : public motion::SweepSink {
 
 TEST(LiveRealTime, MotionStreamDoesNotAllocate) {
   const app::Profile profile = app::default_profile();
-  motion::ToolTable tools(app::tool_config(profile), profile.solid.chord_tol_mm, profile.source);
+  motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   tools.build_all();
   std::array<kin::Kinematics, motion::kMaxChannels> kins{};
   NullSink sink;
@@ -158,7 +158,7 @@ TEST(LiveRealTime, MotionStreamDoesNotAllocate) {
 struct GeometryRig {
   app::Profile profile = app::default_profile();
   geom::LbrSolid solid{profile.solid};
-  motion::ToolTable tools{app::tool_config(profile), profile.solid.chord_tol_mm, profile.source};
+  motion::ToolTable tools{profile.tooling, profile.solid.chord_tol_mm, profile.source};
   sched::SpscRing<hal::AxisSample> ring{4096};
   std::unique_ptr<app::live::Geometry> geo;
   std::uint64_t seq = 0;

@@ -51,8 +51,8 @@ TEST(MachineProfile, DefaultsWithoutTheKeys) {
   EXPECT_DOUBLE_EQ(app::gcode_options(p).work_offsets[0][nc::Z], 0);
   // The built-in default profile sets them all.
   const app::Profile d = app::default_profile();
-  EXPECT_DOUBLE_EQ(d.max_accel_mm_per_s2[2], 1500);
-  EXPECT_DOUBLE_EQ(d.g54_origin_mm[2], -250);
+  EXPECT_DOUBLE_EQ(d.machine.max_accel_mm_per_s2[2], 1500);
+  EXPECT_DOUBLE_EQ(d.machine.g54_origin_mm[2], -250);
 }
 
 TEST(MachineProfile, BadValuesNameFileLineAndKey) {

@@ -24,21 +24,21 @@ const std::string kStock = "[stock]\nshape = \"box\"\nmin_mm = [0, 0, -10]\nmax_
 
 TEST(Profile, DefaultProfile) {
   const app::Profile p = app::default_profile();
-  EXPECT_EQ(p.machine_kind, "mill3");
+  EXPECT_EQ(p.kin.kind, nc::MachineKind::Mill3);
   EXPECT_EQ(p.solid.level_spacing_mm, 0.1);
   EXPECT_EQ(p.solid.regions_x, 4);
   EXPECT_EQ(p.solid.box.max.x, 100.0);
-  ASSERT_EQ(p.tools.size(), 5u);
-  EXPECT_EQ(p.tools.at(5).kind, geom::ToolKind::Bull);
-  EXPECT_EQ(p.tools.at(5).corner_radius_mm, 2.0);
-  EXPECT_EQ(p.tools.at(3).angle_deg, 118.0);
+  ASSERT_EQ(p.tooling.tools.size(), 5u);
+  EXPECT_EQ(p.tooling.tools.at(5).kind, geom::ToolKind::Bull);
+  EXPECT_EQ(p.tooling.tools.at(5).corner_radius_mm, 2.0);
+  EXPECT_EQ(p.tooling.tools.at(3).angle_deg, 118.0);
 }
 
 TEST(Profile, MinimalProfileGetsDefaults) {
   const app::Profile p = app::parse_profile(kStock, "p.toml");
   EXPECT_EQ(p.solid.level_spacing_mm, 0.1);
-  EXPECT_EQ(p.rapid_mm_per_min, 15000.0);
-  EXPECT_TRUE(p.tools.empty());
+  EXPECT_EQ(p.machine.rapid_mm_per_min, 15000.0);
+  EXPECT_TRUE(p.tooling.tools.empty());
 }
 
 TEST(Profile, ErrorsNameFileLineAndKey) {
@@ -64,10 +64,10 @@ TEST(Profile, CommandLineOverrides) {
   EXPECT_EQ(p.solid.shape, geom::SolidSpec::Shape::Cylinder);
   EXPECT_EQ(p.solid.cylinder.diameter_mm, 40.0);
   app::apply_tool_override(p, "7:bull:12:1.5");
-  EXPECT_EQ(p.tools.at(7).corner_radius_mm, 1.5);
+  EXPECT_EQ(p.tooling.tools.at(7).corner_radius_mm, 1.5);
   app::apply_tool_override(p, "1:vbit:10:60");
-  EXPECT_EQ(p.tools.at(1).kind, geom::ToolKind::VBit);
-  EXPECT_EQ(p.tools.at(1).angle_deg, 60.0);
+  EXPECT_EQ(p.tooling.tools.at(1).kind, geom::ToolKind::VBit);
+  EXPECT_EQ(p.tooling.tools.at(1).angle_deg, 60.0);
   app::apply_regions(p, "8x2", "--regions");
   EXPECT_EQ(p.solid.regions_x, 8);
   EXPECT_EQ(p.solid.regions_y, 2);
@@ -144,4 +144,13 @@ TEST(Profile, NcSectionReachesTheInterpreterOptions) {
   EXPECT_EQ(o.subroutine_path[0], "/cfg/subs");
   EXPECT_EQ(o.subroutine_path[1], "/abs/lib");
   EXPECT_NE(error_of(std::string(kStock) + "\n[nc]\nstart_tol = 1\n").find("nc.start_tol: unknown key"), std::string::npos);
+}
+
+// [nc] dialect selects the built-in interpreter's program syntax (docs/nc-frontend.md#fanuc-dialect).
+TEST(Profile, NcDialectReachesTheInterpreterOptions) {
+  EXPECT_EQ(app::gcode_options(app::parse_profile(std::string(kStock), "m.toml")).dialect, nc::Dialect::Rs274ngc);
+  const app::Profile p = app::parse_profile(std::string(kStock) + "\n[nc]\ndialect = \"fanuc\"\n", "m.toml");
+  EXPECT_EQ(app::gcode_options(p).dialect, nc::Dialect::Fanuc);
+  const std::string e = error_of(std::string(kStock) + "\n[nc]\ndialect = \"iso\"\n");
+  EXPECT_NE(e.find("nc.dialect: expected rs274ngc or fanuc; got 'iso'"), std::string::npos) << e;
 }

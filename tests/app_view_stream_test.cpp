@@ -94,7 +94,7 @@ TEST(ViewAnimate, Mill3DemoMatchesBatch) {
 
 TEST(ViewAnimate, UnknownToolNamesTheProgramLine) {
   StreamCase run = load("lathe.toml", "lathe-shaft.ngc");
-  run.profile.inserts.clear();
+  run.profile.tooling.inserts.clear();
   geom::LbrSolid solid(run.profile.solid);
   gfx::SolidExchange ex;
   try {

@@ -67,7 +67,7 @@ double strip_in_circle(double w, double R) {
 TEST(LatheC, FlatAtRadius15OnD40BarRemovesTheCircularSegment) {
   geom::LbrSolid s(bar(-30.0));
   kin::Kinematics k;
-  k.kind = kin::MachineKind::LatheC;
+  k.kind = nc::MachineKind::LatheC;
   // Radial Ø30 end mill facing the axis, spindle positioned at C90; feed along the bar.
   const auto sh = geom::CutterShape::build(test::tool(geom::ToolKind::Flat, 30, 0, 20), kTol);
   move(s, sh, k, kin::Mount::Radial, q_of(15, 0, 20, 0, 0, 90), q_of(15, 0, -50, 0, 0, 90));
@@ -85,7 +85,7 @@ TEST(LatheC, FlatAtRadius15OnD40BarRemovesTheCircularSegment) {
 TEST(LatheC, RadialCrossHoleThroughTheBar) {
   geom::LbrSolid s(bar(-30.0));
   kin::Kinematics k;
-  k.kind = kin::MachineKind::LatheC;
+  k.kind = nc::MachineKind::LatheC;
   const auto sh = geom::CutterShape::build(test::tool(geom::ToolKind::Flat, 8, 0, 60), kTol);
   move(s, sh, k, kin::Mount::Radial, q_of(25, 0, -15, 0, 0, 30), q_of(-25, 0, -15, 0, 0, 30));
   // Mid-plane sampling: per level the strip |y'| <= w(z) of the hole through the disc.
@@ -205,7 +205,7 @@ TEST(LatheC, HexagonByG12_1PolarInterpolation) {
 TEST(Mill5, TiltedFlatEndMillPlungeLeavesTheEllipticalFootprint) {
   geom::LbrSolid s(test::box_spec({-30, -30, -20}, {30, 30, 0}, 0.1));
   kin::Kinematics k;
-  k.kind = kin::MachineKind::Mill5;
+  k.kind = nc::MachineKind::Mill5;
   k.rotary = kin::Rotary::TableAC;
   // A30 tilts the workpiece; a plunge along machine Z is a plunge along the tool axis.
   const double R = 5.0;
@@ -239,7 +239,7 @@ TEST(Mill5, TiltedSlotVolumeMatchesTheClosedForm) {
   // Head B/C with TCP: B30 tilts the tool in XZ; the slot runs along Y through the block.
   geom::LbrSolid s(test::box_spec({-20, 0, -20}, {20, 40, 0}, 0.1));
   kin::Kinematics k;
-  k.kind = kin::MachineKind::Mill5;
+  k.kind = nc::MachineKind::Mill5;
   k.rotary = kin::Rotary::HeadBC;
   k.tcp = true;
   const double R = 5.0, H = 30.0, th = test::kPi / 6;
@@ -280,10 +280,9 @@ TEST(Mill5, ZeroTiltGivesTheSameResultAsMill3) {
       "G1 X20 Z-6\nG0 Z5\n";
   app::Profile p3 = app::default_profile();
   app::Profile p5 = p3;
-  p5.kin.kind = kin::MachineKind::Mill5;
+  p5.kin.kind = nc::MachineKind::Mill5;
   p5.kin.rotary = kin::Rotary::TableAC;
   p5.kin.rotary_center_mm = {37.5, 41.25, -12.3};
-  p5.machine_kind = "mill5";
   const auto path3 = nc::interpret_gcode(prog, "p.ngc", app::gcode_options(p3));
   const auto path5 = nc::interpret_gcode(prog + "G0 A0 C0\n", "p.ngc", app::gcode_options(p5));
   const app::BatchResult r3 = app::run_batch(p3, path3);
@@ -303,7 +302,7 @@ TEST(Mill5, ZeroTiltGivesTheSameResultAsMill3) {
 
 TEST(Mill5, HeadWithoutTcpTurnsAboutThePivot) {
   kin::Kinematics k;
-  k.kind = kin::MachineKind::Mill5;
+  k.kind = nc::MachineKind::Mill5;
   k.rotary = kin::Rotary::HeadBC;
   k.pivot_length_mm = 100.0;
   // Tool 50 long: the pivot is 150 above the programmed tip; B90 swings the tip to +X.
@@ -313,7 +312,7 @@ TEST(Mill5, HeadWithoutTcpTurnsAboutThePivot) {
   EXPECT_NEAR(p.axis.x, 1.0, 1e-12);
   // Table A/C: C90 turns the workpiece, a point at +X of the centre appears at -Y.
   kin::Kinematics t;
-  t.kind = kin::MachineKind::Mill5;
+  t.kind = nc::MachineKind::Mill5;
   t.rotary_center_mm = {5, 5, 0};
   const geom::Pose q = kin::tool_pose(t, q_of(15, 5, 0, 0, 0, 90), kin::Mount::Spindle);
   EXPECT_NEAR(q.tip.x, 5.0, 1e-9);

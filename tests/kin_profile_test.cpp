@@ -28,12 +28,12 @@ TEST(KindsProfile, Mill5KeysReachTheKinematics) {
   const app::Profile p = app::parse_profile("[machine]\nkind = \"mill5\"\nrotary = \"head-bc\"\npivot_length_mm = 120\n"
                                             "tcp = true\nrotary_center_mm = [1, 2, 3]\n" + kBox,
                                             "k.toml");
-  EXPECT_EQ(p.kin.kind, kin::MachineKind::Mill5);
+  EXPECT_EQ(p.kin.kind, nc::MachineKind::Mill5);
   EXPECT_EQ(p.kin.rotary, kin::Rotary::HeadBC);
   EXPECT_DOUBLE_EQ(p.kin.pivot_length_mm, 120);
   EXPECT_TRUE(p.kin.tcp);
   EXPECT_DOUBLE_EQ(p.kin.rotary_center_mm.z, 3);
-  EXPECT_EQ(app::gcode_options(p).machine, nc::MachineKind::MillRotary);
+  EXPECT_EQ(app::gcode_options(p).machine, nc::MachineKind::Mill5);
 }
 
 TEST(KindsProfile, LatheToolsAndMounts) {
@@ -45,14 +45,14 @@ TEST(KindsProfile, LatheToolsAndMounts) {
           "[[tool]]\nnumber = 4\nkind = \"drill\"\ndiameter_mm = 5\nlive = \"radial\"\n"
           "[[tool]]\nnumber = 5\nkind = \"flat\"\ndiameter_mm = 6\n",
       "k.toml");
-  EXPECT_EQ(p.mount_of(1), kin::Mount::Turning);
-  EXPECT_EQ(p.inserts.at(1).insert, geom::InsertKind::V35);
-  EXPECT_DOUBLE_EQ(p.inserts.at(1).approach_deg, 93.0);
-  EXPECT_EQ(p.inserts.at(2).insert, geom::InsertKind::Groove);
-  EXPECT_DOUBLE_EQ(p.inserts.at(2).width_mm, 2.5);
-  EXPECT_TRUE(p.inserts.at(3).internal);
-  EXPECT_EQ(p.mount_of(4), kin::Mount::Radial);
-  EXPECT_EQ(p.mount_of(5), kin::Mount::Axial);  // lathe-c milling tools default to axial
+  EXPECT_EQ(p.tooling.mount_of(1), kin::Mount::Turning);
+  EXPECT_EQ(p.tooling.inserts.at(1).insert, geom::InsertKind::V35);
+  EXPECT_DOUBLE_EQ(p.tooling.inserts.at(1).approach_deg, 93.0);
+  EXPECT_EQ(p.tooling.inserts.at(2).insert, geom::InsertKind::Groove);
+  EXPECT_DOUBLE_EQ(p.tooling.inserts.at(2).width_mm, 2.5);
+  EXPECT_TRUE(p.tooling.inserts.at(3).internal);
+  EXPECT_EQ(p.tooling.mount_of(4), kin::Mount::Radial);
+  EXPECT_EQ(p.tooling.mount_of(5), kin::Mount::Axial);  // lathe-c milling tools default to axial
   EXPECT_DOUBLE_EQ(p.kin.turret_angle_deg, 90);
   const nc::GcodeOptions o = app::gcode_options(p);
   EXPECT_EQ(o.machine, nc::MachineKind::LatheC);

@@ -316,7 +316,7 @@ TEST(GcodeMisc, SpindleCoolantFeedModesAreAccepted) {
 
 TEST(GcodeMachines, RotaryAxesCarried) {
   GcodeOptions o;
-  o.machine = MachineKind::MillRotary;
+  o.machine = MachineKind::Mill5;
   const Toolpath tp = run("G0 A90 B10 C-5\nG91 G1 A10 F100\n", o);
   ASSERT_EQ(tp.segments.size(), 2u);
   EXPECT_DOUBLE_EQ(tp.segments[0].end[A], 90);
@@ -389,7 +389,8 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(GcodeErrors, OWordNamesTheWord) {
   EXPECT_EQ(error_of("O100 sub\n"), "t.ngc:1: 'o100 sub' is never closed");
-  EXPECT_EQ(error_of("G0 X1\nO100\n"), "t.ngc:2: O-word 'O100' without a keyword (sub, call, if, while, do, repeat, ...)");
+  EXPECT_EQ(error_of("G0 X1\nO100\n"), "t.ngc:2: O-word 'O100' without a keyword (sub, call, if, while, do, repeat, ...); "
+                                        "a Fanuc program number needs [nc] dialect = \"fanuc\" or --dialect fanuc");
 }
 
 TEST(GcodeErrors, ArcChordLimitIsAnErrorNotAHang) {

@@ -231,7 +231,7 @@ TEST(NgcDefects, LatheDiameterModeIsTheProfilesInBothFrontEnds) {
 
 TEST(NgcDefects, RotaryWordsForMissingAxesAreRefused) {
   GcodeOptions o;
-  o.machine = MachineKind::MillRotary;
+  o.machine = MachineKind::Mill5;
   o.rotary = {true, false, true};  // A/C table
   EXPECT_EQ(error_of("G0 B10\n", o),
             "t.ngc:1: word 'B10' needs an axis the machine lacks (machine kind mill-rotary has X Y Z A C)");

@@ -1,6 +1,6 @@
 #include "app/batch.hpp"
 
-#include "app/level_pool.hpp"
+#include "geom/parallel_subtractor.hpp"
 #include "motion/path_sweeps.hpp"
 #include "motion/tool_table.hpp"
 
@@ -21,7 +21,7 @@ double distance(const nc::AxisVector& a, const nc::AxisVector& b) {
 
 // Subtracts the moves in order, profile.batch_moves at a time.
 void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& moves, BatchResult& r, const Progress& progress) {
-  LevelPool pool(profile.threads);
+  geom::ParallelSubtractor pool(profile.threads);
   r.threads = pool.threads();
   const auto t0 = std::chrono::steady_clock::now();
   auto last_report = t0;
@@ -46,7 +46,7 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   // while the current one is clipped).
   const std::size_t per = static_cast<std::size_t>(std::max(1, profile.batch_moves));
   std::size_t begin = 0;
-  const LevelPool::BatchSource source = [&](std::vector<geom::SweepRef>& out) {
+  const geom::ParallelSubtractor::BatchSource source = [&](std::vector<geom::SweepRef>& out) {
     if (begin >= moves.size()) return false;
     const std::size_t end = std::min(begin + per, moves.size());
     fill(begin, end, out);
@@ -54,7 +54,7 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
     return true;
   };
   std::size_t done_moves = 0;
-  const LevelPool::BatchDone done = [&](const geom::SubtractStats&) {
+  const geom::ParallelSubtractor::BatchDone done = [&](const geom::SubtractStats&) {
     done_moves = std::min(done_moves + per, moves.size());
     if (!progress) return;
     const auto now = std::chrono::steady_clock::now();
@@ -96,10 +96,10 @@ double machining_time_s(const Profile& profile, const nc::Toolpath& path) {
   nc::AxisVector pos = path.start;
   for (const nc::Segment& s : path.segments) {
     switch (s.kind) {
-      case nc::SegmentKind::Rapid: t += distance(pos, s.end) / profile.rapid_mm_per_min * 60.0; break;
+      case nc::SegmentKind::Rapid: t += distance(pos, s.end) / profile.machine.rapid_mm_per_min * 60.0; break;
       case nc::SegmentKind::Feed: t += distance(pos, s.end) / s.feed_mm_per_min * 60.0; break;
       case nc::SegmentKind::Dwell: t += s.dwell_s; break;
-      case nc::SegmentKind::ToolChange: t += profile.tool_change_s; break;
+      case nc::SegmentKind::ToolChange: t += profile.machine.tool_change_s; break;
     }
     pos = s.end;
   }
@@ -113,7 +113,7 @@ geom::SolidSpec batch_solid_spec(const Profile& profile, const motion::ToolTable
 }
 
 BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress) {
-  motion::ToolTable tools(tool_config(profile), profile.solid.chord_tol_mm, profile.source);
+  motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   tools.require_path(path);
   BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
@@ -126,7 +126,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
 
 BatchResult run_batch_channels(const Profile& profile, const std::vector<ChannelPath>& channels, bool sampled,
                                const Progress& progress) {
-  motion::ToolTable tools(tool_config(profile), profile.solid.chord_tol_mm, profile.source);
+  motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   for (const ChannelPath& c : channels) tools.require_path(c.path);
   BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();

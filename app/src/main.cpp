@@ -37,6 +37,7 @@ using namespace lbr;
 
 struct BatchOptions {
   std::string program, profile, stock, regions, out = "lbrsim-out", interpreter = "builtin";
+  std::string dialect;  // --dialect: overrides the profile's [nc] dialect
   std::string stl, ply;  // mesh exports (empty: none)
   std::vector<std::string> tools;
   double level_spacing = 0.0;
@@ -62,6 +63,7 @@ struct ViewCliOptions {
 
 struct EmulateOptions {
   std::string program, profile, period, out = "samples.csv", interpreter = "builtin";
+  std::string dialect;
   int start_tool = -1;  // --start-tool (-1: the profile's [nc] start_tool)
 };
 
@@ -70,6 +72,16 @@ void add_start_tool_option(CLI::App* c, int& start_tool) {
   c->add_option("--start-tool", start_tool,
                 "Tool in the spindle at program start (0 = empty; default: the profile's [nc] start_tool)")
       ->check(CLI::Range(0, 99999));
+}
+
+// --dialect NAME (rs274ngc, fanuc): the built-in interpreter's program syntax for this run.
+void add_dialect_option(CLI::App* c, std::string& dialect) {
+  c->add_option("--dialect", dialect, "G-code dialect of the built-in interpreter: rs274ngc or fanuc "
+                "(default: the profile's [nc] dialect)")
+      ->check(CLI::IsMember({"rs274ngc", "fanuc"}));
+}
+void apply_dialect(app::Profile& p, const std::string& dialect) {
+  if (!dialect.empty()) (void)nc::parse_dialect(dialect, p.nc.dialect);
 }
 
 // DIR/NAME as the user would type it ("out/" + metrics.json -> out/metrics.json, not out//).
@@ -102,13 +114,14 @@ double parse_period_ms(const std::string& s) {
 
 int run_emulate_command(const EmulateOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
-  if (!o.period.empty()) profile.sample_period_ms = parse_period_ms(o.period);
-  if (o.start_tool >= 0) profile.start_tool = o.start_tool;
+  if (!o.period.empty()) profile.machine.sample_period_ms = parse_period_ms(o.period);
+  apply_dialect(profile, o.dialect);
+  if (o.start_tool >= 0) profile.nc.start_tool = o.start_tool;
   const nc::Toolpath path = app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   nc::Emulator em(path, app::emulator_limits(profile));
   const std::uint64_t n = app::write_samples_csv(o.out, em);
   std::printf("%llu samples every %.4g ms | machining %.3f s | %zu segments | wrote %s\n",
-              static_cast<unsigned long long>(n), profile.sample_period_ms, em.total_time_s(), path.segments.size(),
+              static_cast<unsigned long long>(n), profile.machine.sample_period_ms, em.total_time_s(), path.segments.size(),
               o.out.c_str());
   return 0;
 }
@@ -179,7 +192,8 @@ app::Profile batch_profile(const BatchOptions& o) {
   if (o.level_spacing > 0.0) profile.solid.level_spacing_mm = o.level_spacing;
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
   if (o.threads >= 0) profile.threads = o.threads;
-  if (o.start_tool >= 0) profile.start_tool = o.start_tool;
+  apply_dialect(profile, o.dialect);
+  if (o.start_tool >= 0) profile.nc.start_tool = o.start_tool;
   return profile;
 }
 
@@ -241,7 +255,7 @@ int run_batch_command(const BatchOptions& o) {
     emulated_time_s = nc::emulated_time_s(path, limits);
     if (o.sampled) {
       path = nc::sampled_toolpath(path, limits);
-      spdlog::info("sampled every {} ms: {} segments", profile.sample_period_ms, path.segments.size());
+      spdlog::info("sampled every {} ms: {} segments", profile.machine.sample_period_ms, path.segments.size());
     }
   }
 
@@ -310,7 +324,7 @@ void install_stop_handlers() {
 
 gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profile& profile) {
   gfx::RenderThreadConfig rc;
-  rc.rate_hz = o.rate_hz > 0 ? o.rate_hz : profile.render_rate_hz;
+  rc.rate_hz = o.rate_hz > 0 ? o.rate_hz : profile.render.rate_hz;
   rc.view = gfx::parse_view(o.view);
   rc.ortho = rc.view == gfx::StandardView::Top;
   rc.render.color = gfx::parse_color_mode(o.color);
@@ -504,6 +518,7 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
                     "G-code front end: builtin, or rs274 (LinuxCNC's interpreter, package linuxcnc-uspace)")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  add_dialect_option(batch, b.dialect);
   add_start_tool_option(batch, b.start_tool);
   batch->add_flag("--sampled", b.sampled,
                   "Run the kernel on the machine emulator's sampled stream (as live mode sees it) instead of the "
@@ -538,6 +553,7 @@ CLI::App* add_view_command(CLI::App& cli, BatchOptions& vb, ViewCliOptions& vv) 
   view->add_option("--interpreter", vb.interpreter, "G-code front end: builtin or rs274")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  add_dialect_option(view, vb.dialect);
   view->add_option("--profile", vb.profile, "Machine profile (TOML)");
   add_start_tool_option(view, vb.start_tool);
   view->add_option("--stock", vb.stock, "Override the stock (as for batch)");
@@ -603,6 +619,7 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateOptions& em) {
   emu->add_option("--interpreter", em.interpreter, "G-code front end: builtin or rs274")
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
+  add_dialect_option(emu, em.dialect);
   add_start_tool_option(emu, em.start_tool);
   return emu;
 }
@@ -628,7 +645,7 @@ int run_tune_command(const TuneOptions& o) {
   const nc::Toolpath sampled = nc::sampled_toolpath(path, app::emulator_limits(profile));
   const double machining = nc::emulated_time_s(path, app::emulator_limits(profile));
   double dmax = 1.0;
-  for (const auto& [n, t] : profile.tools) dmax = std::max(dmax, t.diameter_mm);
+  for (const auto& [n, t] : profile.tooling.tools) dmax = std::max(dmax, t.diameter_mm);
   const auto grids = app::tune_candidates(profile, dmax);
   std::printf("tune: %s, %zu samples, %zu grids, one kernel thread\n", o.program.c_str(), sampled.segments.size(),
               grids.size());
@@ -668,8 +685,8 @@ int run_profile_command(const ProfileOptions& o) {
     return 2;
   }
   const app::Profile p = app::load_profile(o.check_path);
-  std::printf("%s: ok (machine %s, %zu tools, level spacing %.4g mm)\n", o.check_path.c_str(), p.machine_kind.c_str(),
-              p.tools.size(), p.solid.level_spacing_mm);
+  std::printf("%s: ok (machine %s, %zu tools, level spacing %.4g mm)\n", o.check_path.c_str(), nc::to_string(p.kin.kind),
+              p.tooling.tools.size(), p.solid.level_spacing_mm);
   return 0;
 }
 

@@ -52,6 +52,9 @@ nc::Toolpath load_toolpath(const std::string& path, const Profile& profile, Inte
   }
   if (is_gcode_path(path)) {
     const nc::GcodeOptions o = gcode_options(profile);
+    if (interpreter == Interpreter::Rs274 && o.dialect == nc::Dialect::Fanuc)
+      throw std::runtime_error(path + ": the fanuc dialect is read by the built-in interpreter only (LinuxCNC's rs274 "
+                               "reads RS274/NGC); drop --interpreter rs274");
     return interpreter == Interpreter::Rs274 ? nc::run_rs274(path, o) : nc::load_gcode(path, o);
   }
   throw std::runtime_error(path + ": unknown program type '" + ext + "' (expected .moves, .ngc, .nc, .gcode or .tap)");
@@ -65,7 +68,7 @@ std::vector<ChannelPath> load_channel_paths(const Profile& profile, Interpreter 
     const std::filesystem::path prog =
         std::filesystem::path(c.program).is_absolute() ? std::filesystem::path(c.program) : dir / c.program;
     Profile per = profile;
-    per.g54_origin_mm = c.g54_origin_mm;
+    per.machine.g54_origin_mm = c.g54_origin_mm;
     channels.push_back({c.name, load_toolpath(prog.string(), per, interpreter), c.kin});
   }
   return channels;

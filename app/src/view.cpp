@@ -34,8 +34,8 @@ std::vector<gfx::ToolState> final_tools(const Profile& profile, const nc::Toolpa
       if (!s.has_tool_axis) pose.axis = axis;
     }
   }
-  const auto it = profile.tools.find(tool);
-  if (it == profile.tools.end()) return {};
+  const auto it = profile.tooling.tools.find(tool);
+  if (it == profile.tooling.tools.end()) return {};
   return {gfx::tool_state(it->second, tool, pose)};
 }
 
@@ -55,7 +55,7 @@ bool has_tool_axes(const std::vector<ChannelPath>& channels) {
 }  // namespace
 
 geom::SolidSpec stream_solid_spec(const Profile& profile, const std::vector<ChannelPath>& channels) {
-  motion::ToolTable tools(tool_config(profile), profile.solid.chord_tol_mm, profile.source);
+  motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   for (const ChannelPath& c : channels) tools.require_path(c.path);
   return batch_solid_spec(profile, tools);
 }
@@ -66,7 +66,7 @@ PathStreamer::PathStreamer(const Profile& profile, const nc::Toolpath& path, geo
 
 PathStreamer::PathStreamer(const Profile& profile, const std::vector<ChannelPath>& channels, geom::LbrSolid& solid,
                            gfx::SolidExchange& ex, StreamOptions opt)
-    : tools_(tool_config(profile), profile.solid.chord_tol_mm, profile.source), solid_(solid), ex_(ex), opt_(opt) {
+    : tools_(profile.tooling, profile.solid.chord_tol_mm, profile.source), solid_(solid), ex_(ex), opt_(opt) {
   for (const ChannelPath& c : channels) tools_.require_path(c.path);
   nc::EmulatorLimits limits = emulator_limits(profile);
   limits.sample_period_ms = opt_.sample_period_s * 1e3;
@@ -106,7 +106,6 @@ void PathStreamer::loop() {
   std::vector<geom::SweepRef> batch;
   batch.reserve(4096);
   batch_ms_.reserve(1 << 16);
-  geom::SubtractWorkspace ws;
   const auto start = clock::now();
   const auto tick = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(opt_.tick_s));
   auto next = start;
@@ -125,7 +124,7 @@ void PathStreamer::loop() {
     }
     if (!batch.empty()) {
       const auto t0 = clock::now();
-      solid_.subtract(batch, ws);
+      solid_.subtract(batch);
       batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
       batches_.fetch_add(1, std::memory_order_relaxed);
       tool_count = tools_at(i, tools);

@@ -24,6 +24,16 @@ void append_polygons(const ClipperLib::PolyTree& tree, std::vector<Polygon>& out
 // its non-zero region inside r. Allocates only when the buffers grow.
 void cut_to_rect(const Path& in, const Rect& r, Path& out, Path& tmp);
 
+// b lies wholly inside a.
+[[nodiscard]] inline bool contains(const Rect& a, const Rect& b) noexcept {
+  return b.x0 >= a.x0 && b.x1 <= a.x1 && b.y0 >= a.y0 && b.y1 <= a.y1;
+}
+
+// The rectangle as a counter-clockwise path.
+[[nodiscard]] inline Path rect_path(const Rect& r) {
+  return Path{{r.x0, r.y0}, {r.x1, r.y0}, {r.x1, r.y1}, {r.x0, r.y1}};
+}
+
 // Bounding box and cached area of a cell recomputed from its polygons.
 void refresh_cell(Cell& cell) noexcept;
 

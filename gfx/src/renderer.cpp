@@ -367,31 +367,53 @@ void Renderer::set_path(std::span<const geom::Vec3> pts) {
 
 FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
   using clock = std::chrono::steady_clock;
-  Gl& g = *gl_;
   FrameInfo fi;
   fi.version = version_;
   const double aspect = static_cast<double>(w) / std::max(h, 1);
   const glm::dmat4 vp = cam.projection(aspect) * cam.view();
-  const Frustum fr(vp);
-  std::vector<char> vis(static_cast<std::size_t>(mirror_.regions()));
-  for (int r = 0; r < mirror_.regions(); ++r) {
-    vis[static_cast<std::size_t>(r)] = fr.intersects(mirror_.region_box(r)) ? 1 : 0;
-    fi.regions_visible += vis[static_cast<std::size_t>(r)];
-  }
+  cull(vp, fi);
+  rebuild_visible(fi);
+  const auto t1 = clock::now();
+  upload_changed(fi);
+  if (path_changed_ && opt_.show_path) upload_path();
+  const auto t2 = clock::now();
+  fi.upload_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  draw_stock(cam, vp, w, h, fi);
+  glDisable(GL_CULL_FACE);
+  if (opt_.show_tools) draw_tools();
+  if (opt_.show_path && gl_->path_count > 1) draw_path();
+  glBindVertexArray(0);
+  if (opt_.show_hud) draw_hud(w, h);
+  fi.draw_ms = std::chrono::duration<double, std::milli>(clock::now() - t2).count();
+  last_ = fi;
+  return fi;
+}
 
-  // 1. Bounded rebuild of visible pending regions; the limit adapts to the time budget.
+// Regions inside the view frustum.
+void Renderer::cull(const glm::dmat4& vp, FrameInfo& fi) {
+  const Frustum fr(vp);
+  visible_.assign(static_cast<std::size_t>(mirror_.regions()), 0);
+  for (int r = 0; r < mirror_.regions(); ++r) {
+    visible_[static_cast<std::size_t>(r)] = fr.intersects(mirror_.region_box(r)) ? 1 : 0;
+    fi.regions_visible += visible_[static_cast<std::size_t>(r)];
+  }
+}
+
+// Bounded rebuild of visible pending regions; the limit adapts to the time budget.
+void Renderer::rebuild_visible(FrameInfo& fi) {
   fi.region_limit = limit_;
-  fi.step = mirror_.step([&](int r) { return vis[static_cast<std::size_t>(r)] != 0; }, limit_);
+  fi.step = mirror_.step([&](int r) { return visible_[static_cast<std::size_t>(r)] != 0; }, limit_);
   if (fi.step.regions_applied > 0) {
     if (fi.step.mesh_ms > opt_.mesh_budget_ms) limit_ = std::max(1, limit_ / 2);
     else if (fi.step.mesh_ms < 0.5 * opt_.mesh_budget_ms && fi.step.regions_applied >= limit_)
       limit_ = std::min(std::max(opt_.max_regions_per_frame, 1), limit_ + 1);
   }
+}
 
-  // 2. Upload regions whose buffers changed.
-  const auto t1 = clock::now();
+// Uploads the regions whose buffers changed.
+void Renderer::upload_changed(FrameInfo& fi) {
   for (int r = 0; r < mirror_.regions(); ++r) {
-    Gl::Region& gr = g.regions[static_cast<std::size_t>(r)];
+    Gl::Region& gr = gl_->regions[static_cast<std::size_t>(r)];
     const mesh::MeshBuffers& mb = mirror_.meshes().region(r);
     if (gr.generation == mb.generation) continue;
     // Joined walls keep zero-area triangles for the mesh's edge identities (docs/mesh.md
@@ -413,19 +435,22 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
     ++gr.uploads;
     ++fi.regions_uploaded;
   }
-  if (path_changed_ && opt_.show_path) {
-    std::vector<float> pts;
-    pts.reserve(path_.size() * 3);
-    for (const geom::Vec3& p : path_) pts.insert(pts.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
-    glBindBuffer(GL_ARRAY_BUFFER, g.path_vbo);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(pts.size() * sizeof(float)), pts.data(), GL_STREAM_DRAW);
-    g.path_count = static_cast<GLsizei>(path_.size());
-    path_changed_ = false;
-  }
-  const auto t2 = clock::now();
-  fi.upload_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+}
 
-  // 3. Draw.
+void Renderer::upload_path() {
+  Gl& g = *gl_;
+  std::vector<float> pts;
+  pts.reserve(path_.size() * 3);
+  for (const geom::Vec3& p : path_) pts.insert(pts.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
+  glBindBuffer(GL_ARRAY_BUFFER, g.path_vbo);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(pts.size() * sizeof(float)), pts.data(), GL_STREAM_DRAW);
+  g.path_count = static_cast<GLsizei>(path_.size());
+  path_changed_ = false;
+}
+
+// Clears the framebuffer and draws the visible regions of the stock.
+void Renderer::draw_stock(const Camera& cam, const glm::dmat4& vp, int w, int h, FrameInfo& fi) {
+  Gl& g = *gl_;
   glViewport(0, 0, w, h);
   glClearColor(0.13f, 0.14f, 0.17f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -437,6 +462,26 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
   glCullFace(GL_BACK);
   glFrontFace(GL_CCW);
   glUseProgram(g.prog);
+  set_scene_uniforms(cam, vp);
+  const int mode = opt_.color == ColorMode::Plain ? 0 : (opt_.color == ColorMode::Heat ? 1 : 2);
+  glUniform1i(g.u_mode, mode);
+  glUniform3f(g.u_color, 0.66f, 0.68f, 0.71f);
+  for (int r = 0; r < mirror_.regions(); ++r) {
+    const Gl::Region& gr = g.regions[static_cast<std::size_t>(r)];
+    if (!visible_[static_cast<std::size_t>(r)] || gr.count == 0) continue;
+    if (mode == 2) {
+      const glm::vec3 c = region_color(r);
+      glUniform3fv(g.u_color, 1, glm::value_ptr(c));
+    }
+    glBindVertexArray(gr.vao);
+    glDrawElements(GL_TRIANGLES, gr.count, GL_UNSIGNED_INT, nullptr);
+    fi.triangles += static_cast<std::uint64_t>(gr.count / 3);
+  }
+}
+
+// Camera, light and colour-scale uniforms shared by everything drawn this frame.
+void Renderer::set_scene_uniforms(const Camera& cam, const glm::dmat4& vp) {
+  Gl& g = *gl_;
   const glm::mat4 vpf = to_f(vp);
   glUniformMatrix4fv(g.u_vp, 1, GL_FALSE, glm::value_ptr(vpf));
   const glm::mat4 ident(1.0f);
@@ -452,90 +497,77 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
   glUniform3f(g.u_lo, static_cast<float>(sb.lo.x), static_cast<float>(sb.lo.y), static_cast<float>(sb.lo.z));
   glUniform3f(g.u_hi, static_cast<float>(sb.hi.x), static_cast<float>(sb.hi.y), static_cast<float>(sb.hi.z));
   glUniform1f(g.u_max_attr, static_cast<float>(std::max<geom::MoveId>(last_move_, 1)));
-  const int mode = opt_.color == ColorMode::Plain ? 0 : (opt_.color == ColorMode::Heat ? 1 : 2);
-  glUniform1i(g.u_mode, mode);
-  glUniform3f(g.u_color, 0.66f, 0.68f, 0.71f);
-  for (int r = 0; r < mirror_.regions(); ++r) {
-    const Gl::Region& gr = g.regions[static_cast<std::size_t>(r)];
-    if (!vis[static_cast<std::size_t>(r)] || gr.count == 0) continue;
-    if (mode == 2) {
-      const glm::vec3 c = region_color(r);
-      glUniform3fv(g.u_color, 1, glm::value_ptr(c));
-    }
-    glBindVertexArray(gr.vao);
-    glDrawElements(GL_TRIANGLES, gr.count, GL_UNSIGNED_INT, nullptr);
-    fi.triangles += static_cast<std::uint64_t>(gr.count / 3);
-  }
+}
 
-  glDisable(GL_CULL_FACE);
-  if (opt_.show_tools) {
-    glUniform1i(g.u_mode, 3);
-    glBindVertexArray(g.cyl_vao);
-    for (int i = 0; i < tool_count_; ++i) {
-      const ToolState& t = tools_[static_cast<std::size_t>(i)];
-      if (t.tool == 0 || t.radius_mm <= 0) continue;
-      const glm::dmat4 f = tool_frame(t.pose);
-      struct Part {
-        double z0, z1, r;
-        glm::vec3 c;
-      };
-      const Part parts[3] = {
-          {0, t.flute_mm, t.radius_mm, {0.85f, 0.55f, 0.20f}},
-          {t.flute_mm, t.length_mm, t.radius_mm * 0.92, {0.70f, 0.71f, 0.74f}},
-          {t.length_mm, t.length_mm + t.holder_length_mm, t.holder_radius_mm, {0.30f, 0.32f, 0.36f}}};
-      for (const Part& p : parts) {
-        if (p.z1 <= p.z0 || p.r <= 0) continue;
-        const glm::dmat4 m = glm::scale(glm::translate(f, glm::dvec3(0, 0, p.z0)), glm::dvec3(p.r, p.r, p.z1 - p.z0));
-        const glm::mat4 mf = to_f(m);
-        glUniformMatrix4fv(g.u_model, 1, GL_FALSE, glm::value_ptr(mf));
-        glUniform3fv(g.u_color, 1, glm::value_ptr(p.c));
-        glDrawElements(GL_TRIANGLES, g.cyl_count, GL_UNSIGNED_INT, nullptr);
-      }
+// Each tool as three cylinders (flutes, shank, holder) in its pose.
+void Renderer::draw_tools() {
+  Gl& g = *gl_;
+  glUniform1i(g.u_mode, 3);
+  glBindVertexArray(g.cyl_vao);
+  for (int i = 0; i < tool_count_; ++i) {
+    const ToolState& t = tools_[static_cast<std::size_t>(i)];
+    if (t.tool == 0 || t.radius_mm <= 0) continue;
+    const glm::dmat4 f = tool_frame(t.pose);
+    struct Part {
+      double z0, z1, r;
+      glm::vec3 c;
+    };
+    const Part parts[3] = {
+        {0, t.flute_mm, t.radius_mm, {0.85f, 0.55f, 0.20f}},
+        {t.flute_mm, t.length_mm, t.radius_mm * 0.92, {0.70f, 0.71f, 0.74f}},
+        {t.length_mm, t.length_mm + t.holder_length_mm, t.holder_radius_mm, {0.30f, 0.32f, 0.36f}}};
+    for (const Part& p : parts) {
+      if (p.z1 <= p.z0 || p.r <= 0) continue;
+      const glm::dmat4 m = glm::scale(glm::translate(f, glm::dvec3(0, 0, p.z0)), glm::dvec3(p.r, p.r, p.z1 - p.z0));
+      const glm::mat4 mf = to_f(m);
+      glUniformMatrix4fv(g.u_model, 1, GL_FALSE, glm::value_ptr(mf));
+      glUniform3fv(g.u_color, 1, glm::value_ptr(p.c));
+      glDrawElements(GL_TRIANGLES, g.cyl_count, GL_UNSIGNED_INT, nullptr);
     }
-    glUniformMatrix4fv(g.u_model, 1, GL_FALSE, glm::value_ptr(ident));
   }
-  if (opt_.show_path && g.path_count > 1) {
-    glUniform1i(g.u_mode, 4);
-    glUniform3f(g.u_color, 1.0f, 0.85f, 0.2f);
-    glBindVertexArray(g.path_vao);
-    glDrawArrays(GL_LINE_STRIP, 0, g.path_count);
-  }
-  glBindVertexArray(0);
+  const glm::mat4 ident(1.0f);
+  glUniformMatrix4fv(g.u_model, 1, GL_FALSE, glm::value_ptr(ident));
+}
 
-  if (opt_.show_hud) {
-    char buf[1024];
-    const LiveStats& L = live_;
-    int n = std::snprintf(buf, sizeof buf,
-                          "frame %.1f ms  period %.1f ms (p99 %.1f)  target %.0f Hz  late %llu\n"
-                          "triangles %llu  regions rebuilt %d (applied %d, pending %d, limit %d)  mesh %.1f ms\n"
-                          "view: %s colour  version %llu  last move %u\n",
-                          pacing_.frame_ms, pacing_.period_ms, pacing_.p99_period_ms, pacing_.rate_hz,
-                          static_cast<unsigned long long>(pacing_.late_frames), static_cast<unsigned long long>(last_.triangles),
-                          last_.step.regions_rebuilt, last_.step.regions_applied, last_.step.regions_pending,
-                          last_.region_limit, last_.step.mesh_ms, to_string(opt_.color),
-                          static_cast<unsigned long long>(version_), last_move_);
-    if (n > 0 && n < static_cast<int>(sizeof buf)) {
-      if (L.live)
-        std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n),
-                      "lag %.1f ms  samples %.0f Hz  ring hw %llu/%llu  overruns %llu  decode errors %llu\n"
-                      "behind: coalesced %llu  held %llu\n"
-                      "%s\n",
-                      L.lag_ms, L.sample_rate_hz, static_cast<unsigned long long>(L.ring_high_water),
-                      static_cast<unsigned long long>(L.ring_capacity), static_cast<unsigned long long>(L.ring_overruns),
-                      static_cast<unsigned long long>(L.decode_errors), static_cast<unsigned long long>(L.samples_coalesced),
-                      static_cast<unsigned long long>(L.samples_held), L.realtime ? "RT (SCHED_FIFO)" : "non-RT");
-      else
-        std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "no live source (batch result)\n");
-    }
-    if (!opt_.notice.empty()) {
-      const std::size_t used = std::strlen(buf);
-      std::snprintf(buf + used, sizeof buf - used, "WARNING: %s\n", opt_.notice.c_str());
-    }
-    g.hud->draw(buf, w, h);
+void Renderer::draw_path() {
+  Gl& g = *gl_;
+  glUniform1i(g.u_mode, 4);
+  glUniform3f(g.u_color, 1.0f, 0.85f, 0.2f);
+  glBindVertexArray(g.path_vao);
+  glDrawArrays(GL_LINE_STRIP, 0, g.path_count);
+}
+
+// The HUD text: the previous frame's figures, the live source's counters, the notice.
+void Renderer::draw_hud(int w, int h) {
+  char buf[1024];
+  const LiveStats& L = live_;
+  int n = std::snprintf(buf, sizeof buf,
+                        "frame %.1f ms  period %.1f ms (p99 %.1f)  target %.0f Hz  late %llu\n"
+                        "triangles %llu  regions rebuilt %d (applied %d, pending %d, limit %d)  mesh %.1f ms\n"
+                        "view: %s colour  version %llu  last move %u\n",
+                        pacing_.frame_ms, pacing_.period_ms, pacing_.p99_period_ms, pacing_.rate_hz,
+                        static_cast<unsigned long long>(pacing_.late_frames), static_cast<unsigned long long>(last_.triangles),
+                        last_.step.regions_rebuilt, last_.step.regions_applied, last_.step.regions_pending,
+                        last_.region_limit, last_.step.mesh_ms, to_string(opt_.color),
+                        static_cast<unsigned long long>(version_), last_move_);
+  if (n > 0 && n < static_cast<int>(sizeof buf)) {
+    if (L.live)
+      std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n),
+                    "lag %.1f ms  samples %.0f Hz  ring hw %llu/%llu  overruns %llu  decode errors %llu\n"
+                    "behind: coalesced %llu  held %llu\n"
+                    "%s\n",
+                    L.lag_ms, L.sample_rate_hz, static_cast<unsigned long long>(L.ring_high_water),
+                    static_cast<unsigned long long>(L.ring_capacity), static_cast<unsigned long long>(L.ring_overruns),
+                    static_cast<unsigned long long>(L.decode_errors), static_cast<unsigned long long>(L.samples_coalesced),
+                    static_cast<unsigned long long>(L.samples_held), L.realtime ? "RT (SCHED_FIFO)" : "non-RT");
+    else
+      std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "no live source (batch result)\n");
   }
-  fi.draw_ms = std::chrono::duration<double, std::milli>(clock::now() - t2).count();
-  last_ = fi;
-  return fi;
+  if (!opt_.notice.empty()) {
+    const std::size_t used = std::strlen(buf);
+    std::snprintf(buf + used, sizeof buf - used, "WARNING: %s\n", opt_.notice.c_str());
+  }
+  gl_->hud->draw(buf, w, h);
 }
 
 FrameInfo Renderer::frame_offscreen(const Camera& cam, int w, int h) {

@@ -16,6 +16,7 @@ namespace lbr::kin {
 namespace {
 
 using geom::Vec3;
+using nc::MachineKind;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 Vec3 rot_x(Vec3 v, double deg) noexcept {
@@ -52,26 +53,6 @@ Vec3 head_axis(Rotary r, const nc::AxisVector& q) noexcept {
 }
 
 }  // namespace
-
-const char* to_string(MachineKind k) noexcept {
-  switch (k) {
-    case MachineKind::Mill3: return "mill3";
-    case MachineKind::Mill5: return "mill5";
-    case MachineKind::Lathe: return "lathe";
-    case MachineKind::LatheC: return "lathe-c";
-  }
-  return "?";
-}
-
-bool parse_machine_kind(const char* s, MachineKind& out) noexcept {
-  for (MachineKind k : {MachineKind::Mill3, MachineKind::Mill5, MachineKind::Lathe, MachineKind::LatheC}) {
-    if (std::strcmp(s, to_string(k)) == 0) {
-      out = k;
-      return true;
-    }
-  }
-  return false;
-}
 
 const char* to_string(Rotary r) noexcept {
   switch (r) {

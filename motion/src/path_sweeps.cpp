@@ -57,7 +57,7 @@ void path_sweeps(const ToolTable& tools, const kin::Kinematics& k, const nc::Too
                  const std::vector<double>* end_time, int channel, geom::MoveId id_base, std::vector<TimedSweep>& out,
                  std::uint64_t& moves) {
   const SweepMapper mapper(tools, k);
-  const bool direct = k.kind == kin::MachineKind::Mill3;
+  const bool direct = k.kind == nc::MachineKind::Mill3;
   geom::Pose pose = pose_of(path.start, path.start_axis);
   nc::AxisVector q = path.start;
   double t = 0.0;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cutter_comp.hpp"
+#include "fanuc.hpp"
 #include "ngc_control.hpp"
 #include "ngc_expr.hpp"
 #include "path_builder.hpp"
@@ -94,6 +95,13 @@ class Interpreter {
         offsets_(o.work_offsets), g28_(o.g28_home), g30_(o.g30_home) {
     selected_tool_ = o.start_tool;
     params_.numbered_hook = [this](int n, double& v) { return system_numbered(n, v); };
+    if (fanuc_) {  // Fanuc variables; its system variables read the same state (fanuc.hpp)
+      params_.use_fanuc_variables();
+      params_.numbered_hook = [this](int n, double& v) {
+        const int m = detail::fanuc_system_variable(n);
+        return m != 0 && system_numbered(m, v);
+      };
+    }
     params_.named_hook = [this](const std::string& n, double& v) { return system_named(n, v); };
     flow_.on_leave([this](int level) { leave_level(level); });
   }
@@ -105,7 +113,11 @@ class Interpreter {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& msg) const { flow_.fail(msg); }
+  // The rs274 hint does not apply to the fanuc dialect, which rs274 cannot read.
+  [[noreturn]] void fail(const std::string& msg) const {
+    const std::size_t hint = fanuc_ ? msg.find(kUseRs274) : std::string::npos;
+    flow_.fail(hint == std::string::npos ? msg : msg.substr(0, hint) + msg.substr(hint + std::string(kUseRs274).size()));
+  }
 
   // One line that is not an O-word line: parameter settings take effect after the whole line
   // has been read (RS274/NGC), then the block executes. Returns true at the program's end.
@@ -228,6 +240,7 @@ class Interpreter {
       const std::size_t num_start = i;
       double v = word_value(s, i, L);
       const std::string written = s.substr(num_start, i - num_start);
+      if (detail::is_vacant(v)) continue;  // fanuc: a word whose value is <vacant> is not given
       if (detail::ExprReader::number_starts(written, written[0] == '+' || written[0] == '-' ? 1 : 0) &&
           written.find_first_of("[#") == std::string::npos && !is_function_at(written, 0))
         v = std::strtod(written.c_str(), nullptr);
@@ -285,7 +298,7 @@ class Interpreter {
   bool axis_allowed(int a) const {
     switch (opt_.machine) {
       case MachineKind::Mill3: return a <= Z;
-      case MachineKind::MillRotary: return a <= Z || opt_.rotary[static_cast<std::size_t>(a - A)];
+      case MachineKind::Mill5: return a <= Z || opt_.rotary[static_cast<std::size_t>(a - A)];
       case MachineKind::Lathe: return a == X || a == Z;
       case MachineKind::LatheC: return a == X || a == Y || a == Z || a == C;
     }
@@ -294,7 +307,7 @@ class Interpreter {
   const char* machine_name() const {
     switch (opt_.machine) {
       case MachineKind::Mill3: return "mill3 has X Y Z";
-      case MachineKind::MillRotary: return rotary_name();
+      case MachineKind::Mill5: return rotary_name();
       case MachineKind::Lathe: return "lathe has X Z";
       case MachineKind::LatheC: return "lathe-c has X Y Z C";
     }
@@ -427,8 +440,8 @@ class Interpreter {
     if (k.mspindle != nullptr) spindle_ = static_cast<int>(k.mspindle->value);
     if (k.mcool != nullptr) coolant_ = static_cast<int>(k.mcool->value);
     if (k.dwell != 0) {
-      if (!has(b, 'P')) fail("'G4' needs P (dwell time [s])");
-      const double p = raw(b, 'P');
+      if (!has(b, 'P') && !fanuc_) fail("'G4' needs P (dwell time [s])");
+      const double p = fanuc_ ? fanuc_dwell_s(b) : raw(b, 'P');
       if (p < 0) fail("'" + text(b, 'P') + "': dwell time must be >= 0");
       if (comp_.active()) comp_.dwell(line_, p);
       else b_.dwell(line_, p);
@@ -456,6 +469,7 @@ class Interpreter {
     Codes k;
     std::vector<const Word*> nonmodal;
     for (const Word& w : b.g) {
+      if (fanuc_ && fanuc_cancel(w)) continue;
       const int gr = group_of(w);
       if (gr < 0) fail(unsupported_g(w));
       if (gr == kNonModal) {
@@ -737,6 +751,7 @@ class Interpreter {
     } else if (motion_ == 330 || motion_ == 331) {
       move_synchronised(b);
     } else if (motion_ == 760) {
+      if (fanuc_) fail("'G76' (in the fanuc dialect the fine boring cycle) is not supported");
       threading_cycle(b);
     } else if (motion_ >= 0) {
       canned_cycle(b);
@@ -867,6 +882,24 @@ class Interpreter {
   }
 
   static bool is_cycle(int c) { return c == 810 || c == 820 || c == 830 || c == 730; }
+
+  // Fanuc safety blocks cancel modes the interpreter never enters: G15 (polar coordinates),
+  // G50.1 (mirror image), G69 (rotation) and, on mills, G50 (scaling). Nothing to do.
+  bool fanuc_cancel(const Word& w) const {
+    const int c = code10(w);
+    const bool mill = opt_.machine == MachineKind::Mill3 || opt_.machine == MachineKind::Mill5;
+    return c == 150 || c == 501 || c == 690 || (c == 500 && mill);
+  }
+
+  // Fanuc G4: P [ms] or X [s]; the X word is the dwell's, not a move.
+  double fanuc_dwell_s(Block& b) {
+    if (has(b, 'P') == has(b, 'X')) fail("'G4' needs P (dwell time [ms]) or X (dwell time [s])");
+    if (has(b, 'P')) return raw(b, 'P') * 0.001;
+    const double s = raw(b, 'X');
+    if (s < 0) fail("'" + text(b, 'X') + "': dwell time must be >= 0");
+    b.has[idx('X')] = false;
+    return s;
+  }
 
   // The program frame: the selected work offset plus the G92 offset while it is applied.
   void select_wcs(int k) {
@@ -1100,6 +1133,7 @@ class Interpreter {
     const double f = feed_for_move(g, has(b, 'F'));
     int repeats = 1;
     if (has(b, 'L')) repeats = integer(b, 'L', 0, static_cast<int>(kMaxRepeats));
+    if (fanuc_ && has(b, 'K')) repeats = integer(b, 'K', 0, static_cast<int>(kMaxRepeats));  // fanuc: K repeats
     AxisVector p = pos();
     // The initial level: the hole-axis position where this series of contiguous canned cycle
     // blocks began. In G91 R is relative to it; G98 retracts to it (or R, the higher), and a
@@ -1152,7 +1186,7 @@ class Interpreter {
       if (motion_ != 830 && motion_ != 730) fail("unused word '" + text(b, 'Q') + "' (" + g + " takes no Q)");
     }
     if (has(b, 'P')) {
-      cs.p = raw(b, 'P');
+      cs.p = raw(b, 'P') * (fanuc_ ? 0.001 : 1.0);  // fanuc: P [ms]
       cs.has_p = true;
       if (motion_ != 820) fail("unused word '" + text(b, 'P') + "' (" + g + " takes no P)");
     }
@@ -1205,6 +1239,7 @@ class Interpreter {
 
   std::string name_;
   const GcodeOptions& opt_;
+  bool fanuc_ = opt_.dialect == Dialect::Fanuc;
   PathBuilder b_;
   detail::Params params_;
   detail::ExprReader expr_;
@@ -1244,6 +1279,13 @@ class Interpreter {
 };
 
 }  // namespace
+
+bool parse_dialect(const std::string& name, Dialect& out) {
+  if (name == "rs274ngc") out = Dialect::Rs274ngc;
+  else if (name == "fanuc") out = Dialect::Fanuc;
+  else return false;
+  return true;
+}
 
 Toolpath interpret_gcode(const std::string& text, const std::string& name, const GcodeOptions& options) {
   if (!(options.chord_tol_mm > 0.0)) throw ParseError(name, 0, "chord tolerance must be > 0 mm");

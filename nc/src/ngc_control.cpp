@@ -6,12 +6,17 @@
 //   end:  if/elseif/else -> the endif; while/do/repeat -> the line closing the loop;
 //         sub -> its endsub.
 // so that running a program is a walk over an index with a stack of activations (one per
-// subroutine call), as LinuxCNC's interpreter does it with its offset table.
+// subroutine call), as LinuxCNC's interpreter does it with its offset table. The fanuc
+// dialect's scanner (fanuc.cpp) fills the same indices for WHILE/DO/END; its other
+// statements (M98/M99 calls with passes, GOTO, #i = ..., G66) are run at the end of this file.
 #include "ngc_control.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+
+#include "fanuc.hpp"
 
 namespace lbr::nc::detail {
 
@@ -182,7 +187,7 @@ class Matcher {
 
 }  // namespace
 
-std::unique_ptr<NgcFile> scan_program(const std::string& text, const std::string& path) {
+std::unique_ptr<NgcFile> read_program_lines(const std::string& text, const std::string& path) {
   auto f = std::make_unique<NgcFile>();
   f->path = path;
   std::size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // UTF-8 byte order mark
@@ -205,12 +210,18 @@ std::unique_ptr<NgcFile> scan_program(const std::string& text, const std::string
         err = e.what();
       }
     }
-    f->ow.push_back(parse_oword(line.code));
     f->lines.push_back(std::move(line));
     f->errors.push_back(std::move(err));
   }
+  f->ow.assign(f->lines.size(), OWord{});
   f->link.assign(f->lines.size(), kNone);
   f->end.assign(f->lines.size(), kNone);
+  return f;
+}
+
+std::unique_ptr<NgcFile> scan_program(const std::string& text, const std::string& path) {
+  auto f = read_program_lines(text, path);
+  for (std::size_t i = 0; i < f->lines.size(); ++i) f->ow[i] = parse_oword(f->lines[i].code);
   Matcher(*f).run();
   return f;
 }
@@ -233,12 +244,13 @@ void ControlFlow::fail(const std::string& msg) const {
 
 void ControlFlow::run(const std::string& text, const std::string& name) {
   files_.clear();
-  files_.push_back(scan_program(text, name));
+  files_.push_back(opt_.dialect == Dialect::Fanuc ? scan_fanuc(text, name, true) : scan_program(text, name));
+  modal_ = {};
   search_dirs_.clear();
   const std::filesystem::path dir = std::filesystem::path(name).parent_path();
   search_dirs_.push_back(dir.empty() ? std::string(".") : dir.string());
   for (const std::string& d : opt_.subroutine_path) search_dirs_.push_back(d);
-  stack_.assign(1, Activation{files_.front().get(), 0, "", {}});
+  stack_.assign(1, activation(files_.front().get(), 0, ""));
   try {
     while (step()) {
     }
@@ -251,7 +263,8 @@ bool ControlFlow::step() {
   Activation& a = stack_.back();
   const NgcFile& f = *a.file;
   if (a.pc >= f.lines.size()) {
-    if (stack_.size() > 1) fail("end of file inside subroutine o" + a.label);
+    if (stack_.size() > 1) a.pc = f.lines.size() - 1;  // reported at the file's last line
+    if (stack_.size() > 1) fail(f.fanuc ? "program O" + a.label + " ends without M99" : "end of file inside subroutine o" + a.label);
     return false;
   }
   if (opt_.max_blocks > 0 && ++executed_ > opt_.max_blocks)
@@ -259,16 +272,22 @@ bool ControlFlow::step() {
   const std::size_t i = a.pc;
   if (!f.errors[i].empty()) fail(f.errors[i]);
   const OWord& o = f.ow[i];
-  if (o.label.empty()) {
+  if (o.kind == OKind::None && o.label.empty()) {
     const bool ended = exec_(f.lines[i]);
     stack_.back().pc = i + 1;
+    if (!ended && o.axis_words && modal_.on) after_block(i);
     return !ended;
   }
-  oword(o);
-  return true;
+  if (o.block_first && exec_(f.lines[i])) return false;
+  return oword(o);
 }
 
 double ControlFlow::condition(const OWord& o) {
+  if (stack_.back().file->fanuc) {  // "[...]" at rest; what follows (GOTO, DO, THEN) is the scanner's
+    std::size_t p = o.rest;
+    const double v = expr_.bracketed(o.words, p);
+    return is_vacant(v) ? 0.0 : v;
+  }
   const std::string& code = stack_.back().file->lines[stack_.back().pc].code;
   std::size_t p = o.rest;
   if (p >= code.size()) fail(owtext(o) + " needs an expression in [ ]");
@@ -291,16 +310,36 @@ void ControlFlow::branch_false(std::size_t i) {
   a.pc = j + 1;  // else: its body; endif: after it
 }
 
-void ControlFlow::oword(const OWord& o) {
+bool ControlFlow::oword(const OWord& o) {
   Activation& a = stack_.back();
   const NgcFile& f = *a.file;
   const std::size_t i = a.pc;
   switch (o.kind) {
-    case OKind::None: fail("O-word 'O" + o.label + "' without a keyword (sub, call, if, while, do, repeat, ...)");
-    case OKind::Sub: a.pc = f.end[i] + 1; break;
+    case OKind::None:
+      fail("O-word 'O" + o.label + "' without a keyword (sub, call, if, while, do, repeat, ...)" +
+           (o.label.find_first_not_of("0123456789") == std::string::npos
+                ? "; a Fanuc program number needs [nc] dialect = \"fanuc\" or --dialect fanuc"
+                : ""));
+    case OKind::Sub:
+      if (f.fanuc && stack_.size() > 1) fail("program O" + a.label + " runs into program O" + o.label + " (no M99)");
+      a.pc = f.end[i] + 1;
+      break;
     case OKind::EndSub:
-    case OKind::Return: leave(o); break;
-    case OKind::Call: call(o); break;
+    case OKind::Return:
+      if (f.fanuc) return fanuc_return(o);
+      leave(o);
+      break;
+    case OKind::Call:
+      if (f.fanuc) fanuc_call(o);
+      else call(o);
+      break;
+    case OKind::Goto: go_to(o); break;
+    case OKind::Assign: assign(o); break;
+    case OKind::ModalCall: modal_call(o); break;
+    case OKind::EndModalCall:
+      modal_.on = false;
+      a.pc = i + 1;
+      break;
     case OKind::If:
       if (condition(o) != 0.0) a.pc = i + 1;
       else branch_false(i);
@@ -340,6 +379,7 @@ void ControlFlow::oword(const OWord& o) {
       break;
     }
   }
+  return true;
 }
 
 void ControlFlow::call(const OWord& o) {
@@ -356,7 +396,7 @@ void ControlFlow::call(const OWord& o) {
   const NgcFile* file = find_sub(o.label, at);
   params_.push_frame(args);
   params_.set_named("_VALUE_RETURNED", 0.0);
-  stack_.push_back(Activation{file, at + 1, o.label, {}});
+  stack_.push_back(activation(file, at + 1, o.label));
 }
 
 void ControlFlow::leave(const OWord& o) {
@@ -398,6 +438,7 @@ const NgcFile* ControlFlow::find_sub(const std::string& label, std::size_t& at) 
 
 // LinuxCNC looks for "name.ngc" (lower case) on its SUBROUTINE_PATH for o<name> call.
 const NgcFile* ControlFlow::load_sub_file(const std::string& label) {
+  if (files_.front()->fanuc) return load_fanuc_file(label);
   std::string name = label;
   if (name.size() < 3 || name.front() != '<') fail("subroutine o" + label + " is not defined");
   name = name.substr(1, name.size() - 2);
@@ -415,6 +456,135 @@ const NgcFile* ControlFlow::load_sub_file(const std::string& label) {
   }
   fail("subroutine o<" + name + "> is not defined in the program and " + name + ".ngc is not in " + dirs.str() +
        " (program directory, [nc] subroutine_path)");
+}
+
+}  // namespace lbr::nc::detail
+
+// ---- fanuc dialect statements (fanuc.hpp) ---------------------------------------------------
+
+namespace lbr::nc::detail {
+
+// M98 P L (shares the caller's locals) and G65 P L (locals #1..#33 from the arguments).
+void ControlFlow::fanuc_call(const OWord& o) {
+  const FanucCall c = read_fanuc_call(o.words, o.label != "M98", expr_);
+  if (c.count <= 0) {
+    stack_.back().pc += 1;
+    return;
+  }
+  enter(c.label, c.args, o.label != "M98", c.count);
+}
+
+void ControlFlow::enter(const std::string& label, const std::vector<double>& args, bool frame, long count) {
+  if (call_level() >= kMaxCallDepth)
+    fail("program O" + label + ": calls nested deeper than " + std::to_string(kMaxCallDepth));
+  std::size_t at = 0;
+  const NgcFile* file = find_sub(label, at);
+  if (frame) params_.push_frame(args);
+  Activation act = activation(file, at + 1, label);
+  act.passes = count;
+  act.entry = at + 1;
+  act.args = args;
+  act.frame = frame;
+  stack_.push_back(std::move(act));
+}
+
+// M99 [P n]: the next pass of the call, or back to the caller (to its block N n with P).
+// In the main program M99 ends it (docs/nc-frontend.md#fanuc-dialect).
+bool ControlFlow::fanuc_return(const OWord& o) {
+  const long target = o.words.empty() ? -1 : read_return_target(o.words, expr_);
+  if (stack_.size() <= 1) return false;
+  Activation& a = stack_.back();
+  if (--a.passes > 0) {
+    if (a.frame) {
+      params_.pop_frame();
+      params_.push_frame(a.args);
+    }
+    a.pc = a.entry;
+    return true;
+  }
+  if (on_leave_) on_leave_(call_level());
+  if (a.frame) params_.pop_frame();
+  stack_.pop_back();
+  if (target >= 0) jump_to_number(target, "M99 P" + std::to_string(target));
+  else stack_.back().pc += 1;
+  return true;
+}
+
+void ControlFlow::go_to(const OWord& o) {
+  if (o.rest != kNone && condition(o) == 0.0) {
+    stack_.back().pc += 1;
+    return;
+  }
+  std::size_t p = o.target;
+  const double v = expr_.value(o.words, p);
+  if (p != o.words.size()) fail("unexpected '" + o.words.substr(p) + "' after GOTO");
+  if (is_vacant(v) || v != std::floor(v) || v < 0 || v > 99999) fail("GOTO needs a sequence number 0..99999");
+  jump_to_number(static_cast<long>(v), "GOTO " + std::to_string(static_cast<long>(v)));
+}
+
+// Fanuc searches the executing program (not the others in the file) for block N n.
+void ControlFlow::jump_to_number(long n, const std::string& what) {
+  Activation& a = stack_.back();
+  const NgcFile& f = *a.file;
+  const std::size_t owner = f.owner[a.pc];
+  const auto [lo, hi] = f.numbers.equal_range(n);
+  for (auto it = lo; it != hi; ++it) {
+    if (f.owner[it->second] == owner) {
+      a.pc = it->second;
+      return;
+    }
+  }
+  fail(what + ": no block N" + std::to_string(n) + " in " +
+       (owner == kNone ? std::string("the main program") : "program O" + f.ow[owner].label));
+}
+
+// #i = expression, or IF [condition] THEN #i = expression. #3000 = n raises alarm 3000 + n
+// with the block's comment as its message: the program is refused there.
+void ControlFlow::assign(const OWord& o) {
+  if (o.rest == kNone || condition(o) != 0.0) {
+    std::size_t p = o.target;
+    const ParamAssign pa = expr_.assignment(o.words, p);
+    if (p != o.words.size()) fail("unexpected '" + o.words.substr(p) + "' after the assignment");
+    if (pa.number == 3000) {
+      const NormalisedLine& l = stack_.back().file->lines[stack_.back().pc];
+      const double n = is_vacant(pa.value) ? 0.0 : std::clamp(std::floor(pa.value), -1e6, 1e6);
+      fail("macro alarm " + std::to_string(3000 + static_cast<long>(n)) + " (#3000): " +
+           (l.comments.empty() ? std::string("no message") : l.comments.front()));
+    }
+    params_.set_numbered(pa.number, pa.value);
+  }
+  stack_.back().pc += 1;
+}
+
+void ControlFlow::modal_call(const OWord& o) {
+  const FanucCall c = read_fanuc_call(o.words, true, expr_);
+  modal_ = {true, c.label, c.args, c.count, stack_.size()};
+  stack_.back().pc += 1;
+}
+
+// After a block with axis words under G66: call the macro; the return goes to the next line.
+void ControlFlow::after_block(std::size_t i) {
+  if (stack_.size() != modal_.level || modal_.count <= 0) return;
+  stack_.back().pc = i;
+  enter(modal_.label, modal_.args, true, modal_.count);
+}
+
+const NgcFile* ControlFlow::load_fanuc_file(const std::string& label) {
+  std::ostringstream dirs;
+  const std::vector<std::string> names = fanuc_file_names(label);
+  for (const std::string& d : search_dirs_) {
+    dirs << (dirs.tellp() > 0 ? ", " : "") << d;
+    for (const std::string& name : names) {
+      const std::filesystem::path p = std::filesystem::path(d) / name;
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(p, ec)) continue;
+      files_.push_back(scan_fanuc(read_text_file(p.string()), p.string(), false));
+      if (files_.back()->subs.count(label) == 0) fail("program file " + p.string() + " does not hold program O" + label);
+      return files_.back().get();
+    }
+  }
+  fail("program O" + label + " is not in this file, and no file " + names.front() + " or " + names[1] + " is in " +
+       dirs.str() + " (program directory, [nc] subroutine_path)");
 }
 
 }  // namespace lbr::nc::detail

@@ -7,6 +7,9 @@
 // interpreter). Subroutines called by name that the program does not define are read from
 // NAME.ngc in the program's directory, then in GcodeOptions::subroutine_path (as LinuxCNC's
 // SUBROUTINE_PATH). Errors are ParseError naming the file and line where they happen.
+// The fanuc dialect (fanuc.hpp) is a second scanner over the same walk: its statements
+// (M98/M99, G65/G66/G67, IF/GOTO, WHILE/DO/END, #i=...) become OWord entries of the same
+// NgcFile, with the few kinds NGC lacks (Goto, Assign, ModalCall, EndModalCall).
 // Not real-time code: allocates and throws.
 #pragma once
 
@@ -24,13 +27,23 @@ namespace lbr::nc::detail {
 
 enum class OKind : unsigned char {
   None, Sub, EndSub, Call, Return, If, ElseIf, Else, EndIf, While, EndWhile, Do, DoWhile, Repeat, EndRepeat,
-  Break, Continue
+  Break, Continue,
+  Goto, Assign, ModalCall, EndModalCall  // fanuc dialect only
 };
 
 struct OWord {
   OKind kind = OKind::None;
   std::string label;     // "100" or "<NAME>" (normalised: upper case, no blanks)
   std::size_t rest = 0;  // position in the line's code after the keyword
+  // Fanuc statements (fanuc.hpp): `label` is the keyword as written (M98, G65, WHILE, ...),
+  // `words` the statement's text, which `rest` (its [condition]; npos: none) and `target`
+  // (GOTO's N number, the '#' of an assignment) index. block_first: the line's other words
+  // (its code) run as a block before the statement ("X10. M98 P100"). axis_words: an
+  // ordinary block with axis words (a G66 modal call follows it).
+  std::string words;
+  std::size_t target = 0;
+  bool block_first = false;
+  bool axis_words = false;
 };
 
 // One program or subroutine file, read and matched.
@@ -42,8 +55,14 @@ struct NgcFile {
   std::vector<std::size_t> link;        // per O-line: partner (see ngc_control.cpp)
   std::vector<std::size_t> end;         // per O-line: end of its construct
   std::map<std::string, std::size_t> subs;  // label -> line index of its 'sub'
+  bool fanuc = false;                       // scanned by scan_fanuc (fanuc.hpp)
+  std::multimap<long, std::size_t> numbers;  // fanuc: N number -> line (GOTO targets)
+  std::vector<std::size_t> owner;           // fanuc: per line, its program's O line (npos: main)
 };
 
+// Reads the lines of a program file up to the closing '%', normalised; ow, link and end are
+// sized and empty (the scanners fill them).
+[[nodiscard]] std::unique_ptr<NgcFile> read_program_lines(const std::string& text, const std::string& path);
 // Reads `text` as a program file. Throws ParseError for unmatched O-words.
 [[nodiscard]] std::unique_ptr<NgcFile> scan_program(const std::string& text, const std::string& path);
 
@@ -77,10 +96,38 @@ class ControlFlow {
     std::size_t pc = 0;
     std::string label;                         // subroutine label ("" for the main program)
     std::map<std::size_t, long> repeats;       // repeat line -> remaining passes
+    // Fanuc calls (M98 P L, G65 P L): passes left, where a pass starts, the arguments each
+    // pass gets, and whether the call has its own locals (G65) or shares the caller's (M98).
+    long passes = 1;
+    std::size_t entry = 0;
+    std::vector<double> args;
+    bool frame = true;
+  };
+  struct ModalCall {  // G66: the macro called after each block with axis words
+    bool on = false;
+    std::string label;
+    std::vector<double> args;
+    long count = 1;
+    std::size_t level = 0;  // stack depth where G66 was given (moves inside the macro do not call)
   };
 
+  static Activation activation(const NgcFile* file, std::size_t pc, const std::string& label) {
+    Activation a;
+    a.file = file, a.pc = pc, a.label = label;
+    return a;
+  }
   bool step();  // executes the line at pc; false when the program has ended
-  void oword(const OWord& o);
+  bool oword(const OWord& o);  // false when the program has ended
+  // Fanuc statements (fanuc.hpp).
+  void fanuc_call(const OWord& o);
+  bool fanuc_return(const OWord& o);
+  void enter(const std::string& label, const std::vector<double>& args, bool frame, long count);
+  void go_to(const OWord& o);
+  void jump_to_number(long n, const std::string& what);
+  void assign(const OWord& o);
+  void modal_call(const OWord& o);
+  void after_block(std::size_t i);
+  const NgcFile* load_fanuc_file(const std::string& label);
   void branch_false(std::size_t i);
   void call(const OWord& o);
   void leave(const OWord& o);
@@ -96,6 +143,7 @@ class ControlFlow {
   std::vector<Activation> stack_;
   std::vector<std::string> search_dirs_;
   long executed_ = 0;
+  ModalCall modal_;
   std::function<void(int level)> on_leave_;
 };
 

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -119,17 +120,34 @@ NormalisedLine normalise_line(std::string_view raw) {
 
 // ---- parameters ----------------------------------------------------------------------------
 
+double vacant() { return std::numeric_limits<double>::quiet_NaN(); }
+bool is_vacant(double v) { return std::isnan(v); }
+
 Params::Params() : numbered_(kMaxNumberedParam + 1, 0.0), frames_(1) {}
+
+void Params::use_fanuc_variables() {
+  fanuc_ = true;
+  locals_ = kFanucLocalParams;
+  numbered_.assign(numbered_.size(), vacant());
+}
+
+namespace {
+bool fanuc_settable(int n) { return (n >= 1 && n <= kFanucLocalParams) || (n >= 100 && n <= 199) || (n >= 500 && n <= 999); }
+std::string fanuc_ranges() { return "(locals #1-#33, common #100-#199 and #500-#999; docs/nc-frontend.md#fanuc-dialect)"; }
+}  // namespace
 
 double Params::numbered(int n) const {
   double v = 0.0;
   if (numbered_hook && numbered_hook(n, v)) return v;
+  if (fanuc_ && n == 0) return vacant();
+  if (fanuc_ && !fanuc_settable(n)) throw ExprError("variable #" + std::to_string(n) + " is not supported " + fanuc_ranges());
   if (n < 1 || n > kMaxNumberedParam)
     throw ExprError("parameter number " + std::to_string(n) + " out of range [1, " + std::to_string(kMaxNumberedParam) + "]");
   return numbered_[static_cast<std::size_t>(n)];
 }
 
 void Params::set_numbered(int n, double v) {
+  if (fanuc_ && !fanuc_settable(n)) throw ExprError("variable #" + std::to_string(n) + " cannot be set " + fanuc_ranges());
   if (n < 1 || n > kMaxNumberedParam)
     throw ExprError("parameter number " + std::to_string(n) + " out of range [1, " + std::to_string(kMaxNumberedParam) + "]");
   numbered_[static_cast<std::size_t>(n)] = v;
@@ -158,17 +176,17 @@ void Params::set_named(const std::string& name, double v) {
 
 void Params::push_frame(const std::vector<double>& args) {
   Frame f;
-  for (int i = 0; i < kLocalParams; ++i) {
+  for (int i = 0; i < locals_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     f.saved[k] = numbered_[k + 1];
-    numbered_[k + 1] = k < args.size() ? args[k] : 0.0;
+    numbered_[k + 1] = k < args.size() ? args[k] : fanuc_ ? vacant() : 0.0;
   }
   frames_.push_back(std::move(f));
 }
 
 void Params::pop_frame() {
   if (frames_.size() <= 1) return;
-  for (std::size_t k = 0; k < kLocalParams; ++k) numbered_[k + 1] = frames_.back().saved[k];
+  for (std::size_t k = 0; k < static_cast<std::size_t>(locals_); ++k) numbered_[k + 1] = frames_.back().saved[k];
   frames_.pop_back();
 }
 
@@ -198,7 +216,9 @@ double ExprReader::value(std::string_view s, std::size_t& pos) {
   const char c = s[pos];
   if (c == '+' || c == '-') {
     ++pos;
-    v = c == '-' ? -value(s, pos) : value(s, pos);
+    v = value(s, pos);
+    if (params_.fanuc() && is_vacant(v)) v = 0.0;  // <vacant> in arithmetic is 0
+    if (c == '-') v = -v;
   } else if (c == '[') {
     v = bracketed(s, pos);
   } else if (c == '#') {
@@ -228,9 +248,19 @@ double ExprReader::binary(std::string_view s, std::size_t& pos, int level) {
     if (op == nullptr || op->level != level) break;
     pos += std::string_view(op->text).size();
     const double right = binary(s, pos, level + 1);
-    left = checked(apply(op->text, left, right));
+    left = checked(operate(op->text, left, right));
   }
   return left;
+}
+
+// Fanuc's <vacant>: EQ / NE tell it from every number (also 0); elsewhere it is 0.
+double ExprReader::operate(std::string_view op, double a, double b) const {
+  if (!params_.fanuc()) return apply(op, a, b);
+  if ((op == "EQ" || op == "NE") && (is_vacant(a) || is_vacant(b))) {
+    const bool equal = is_vacant(a) && is_vacant(b);
+    return (op == "EQ") == equal ? 1.0 : 0.0;
+  }
+  return apply(op, is_vacant(a) ? 0.0 : a, is_vacant(b) ? 0.0 : b);
 }
 
 std::string ExprReader::param_name(std::string_view s, std::size_t& pos) {
@@ -246,12 +276,13 @@ std::string ExprReader::param_name(std::string_view s, std::size_t& pos) {
 int ExprReader::param_number(std::string_view s, std::size_t& pos) {
   const double v = value(s, pos);
   const double r = std::nearbyint(v);
-  if (std::abs(v - r) > 1e-4 || r < 1 || r > kMaxNumberedParam)
+  const int lowest = params_.fanuc() ? 0 : 1;  // Fanuc #0: <vacant>
+  if (!(std::abs(v - r) <= 1e-4) || r < lowest || r > kMaxNumberedParam)
     throw ExprError("parameter number " + [&] {
       std::ostringstream o;
       o << v;
       return o.str();
-    }() + " is not an integer in [1, " +
+    }() + " is not an integer in [" + std::to_string(lowest) + ", " +
                     std::to_string(kMaxNumberedParam) + "]");
   return static_cast<int>(r);
 }
@@ -276,6 +307,7 @@ double ExprReader::function(std::string_view s, std::size_t& pos) {
   }
   if (pos >= s.size() || s[pos] != '[')
     throw ExprError("unexpected '" + std::string(f) + "' (expected a number, a parameter or an expression)");
+  if (params_.fanuc()) return fanuc_function(f, s, pos);
   const double x = bracketed(s, pos);
   if (f == "ATAN") {
     expect(s, pos, '/', "in ATAN[y]/[x]");
@@ -285,13 +317,61 @@ double ExprReader::function(std::string_view s, std::size_t& pos) {
   return checked(unary(f, x));
 }
 
+// Fanuc's functions: one or two arguments ("ATAN[y]/[x]", "ATAN[y,x]", "POW[a,b]"); FIX and
+// FUP round towards and away from zero; ATAN answers in [0, 360); <vacant> arguments are 0.
+double ExprReader::fanuc_function(std::string_view f, std::string_view s, std::size_t& pos) {
+  expect(s, pos, '[', "to open the argument");
+  auto arg = [&] {
+    const double v = binary(s, pos, 1);
+    return is_vacant(v) ? 0.0 : v;
+  };
+  const double x = arg();
+  if (f == "ATAN" || f == "POW") {
+    double y = 0.0;
+    const bool two = pos < s.size() && s[pos] == ',';
+    if (two) ++pos, y = arg();
+    expect(s, pos, ']', "to close the argument");
+    if (f == "POW") {
+      if (!two) throw ExprError("POW needs two arguments: POW[base,exponent]");
+      return checked(apply("**", x, y));
+    }
+    if (!two && (pos >= s.size() || s[pos] != '/')) return std::atan(x) / kDeg;  // ATAN[x]: (-90, 90)
+    if (!two) {
+      ++pos;
+      y = bracketed(s, pos);
+    }
+    const double deg = std::atan2(x, is_vacant(y) ? 0.0 : y) / kDeg;
+    return deg < 0.0 ? deg + 360.0 : deg;
+  }
+  expect(s, pos, ']', "to close the argument");
+  if (f == "FIX") return std::trunc(x);
+  if (f == "FUP") return x < 0.0 ? -std::ceil(-x) : std::ceil(x);
+  if (f == "BIN" || f == "BCD") {
+    if (x < 0.0 || x > 99999999.0 || x != std::floor(x)) throw ExprError(std::string(f) + " needs an integer in [0, 99999999]");
+    auto n = static_cast<unsigned long long>(x);
+    unsigned long long out = 0, scale = 1;
+    for (; n > 0; scale *= f == "BIN" ? 10 : 16) {
+      const unsigned long long digit = f == "BIN" ? n % 16 : n % 10;
+      if (digit > 9) throw ExprError("BIN of a value that is not BCD");
+      out += digit * scale;
+      n /= f == "BIN" ? 16 : 10;
+    }
+    return static_cast<double>(out);
+  }
+  return checked(unary(f, x));
+}
+
 ParamAssign ExprReader::assignment(std::string_view s, std::size_t& pos) {
   ParamAssign a;
   expect(s, pos, '#', "");
-  if (pos < s.size() && s[pos] == '<') a.name = param_name(s, pos);
-  else a.number = param_number(s, pos);
+  if (pos < s.size() && s[pos] == '<') {
+    if (params_.fanuc()) throw ExprError("named parameters '#<...>' are not part of the fanuc dialect");
+    a.name = param_name(s, pos);
+  } else {
+    a.number = param_number(s, pos);
+  }
   expect(s, pos, '=', "in a parameter setting");
-  a.value = value(s, pos);
+  a.value = params_.fanuc() ? binary(s, pos, 1) : value(s, pos);
   return a;
 }
 

@@ -36,12 +36,18 @@ struct NormalisedLine {
 
 inline constexpr int kMaxNumberedParam = 5602;  // #1 .. #5602 as in LinuxCNC
 inline constexpr int kLocalParams = 30;         // #1 .. #30 are local to a subroutine call
+inline constexpr int kFanucLocalParams = 33;    // Fanuc dialect: #1 .. #33
 
 // Parameter storage: numbered parameters, named locals per call frame, named globals
 // (names starting with '_'). Read-only system values come from the hooks.
 class Params {
  public:
   Params();
+  // Fanuc macro variables (docs/nc-frontend.md#fanuc-dialect): #0 and every variable not set
+  // yet are <vacant>, held as NaN (is_vacant); locals are #1..#33; only #1..#33, #100..#199
+  // and #500..#999 can be set; the Fanuc functions (POW, BIN, BCD, ATAN[y,x]) are known.
+  void use_fanuc_variables();
+  [[nodiscard]] bool fanuc() const { return fanuc_; }
   // Hooks for computed read-only parameters (#5420.., #<_x>, ...): return true and set v.
   std::function<bool(int, double&)> numbered_hook;
   std::function<bool(const std::string&, double&)> named_hook;
@@ -53,20 +59,27 @@ class Params {
   [[nodiscard]] bool named_exists(const std::string& name) const;
   void set_named(const std::string& name, double v);
 
-  // Subroutine frames: push saves #1..#30 and sets them to `args` (the rest 0); pop restores.
+  // Subroutine frames: push saves the locals (#1..#30; Fanuc #1..#33) and sets them to `args`
+  // (the rest 0; Fanuc: vacant); pop restores.
   void push_frame(const std::vector<double>& args);
   void pop_frame();
   [[nodiscard]] int depth() const { return static_cast<int>(frames_.size()) - 1; }
 
  private:
   struct Frame {
-    std::array<double, kLocalParams> saved{};
+    std::array<double, kFanucLocalParams> saved{};
     std::map<std::string, double> locals;
   };
   std::vector<double> numbered_;
   std::map<std::string, double> globals_;
   std::vector<Frame> frames_;
+  bool fanuc_ = false;
+  int locals_ = kLocalParams;
 };
+
+// Fanuc's <vacant> value (Params::use_fanuc_variables).
+[[nodiscard]] double vacant();
+[[nodiscard]] bool is_vacant(double v);
 
 // A pending parameter assignment of a line: applied after the whole line has been read.
 struct ParamAssign {
@@ -81,7 +94,8 @@ class ExprReader {
   explicit ExprReader(Params& p) : params_(p) {}
   // A real value: number, parameter, [expression], function, or a sign before one of them.
   [[nodiscard]] double value(std::string_view s, std::size_t& pos);
-  // "#ref=value" at pos (pos at '#'): the assignment target and value.
+  // "#ref=value" at pos (pos at '#'): the assignment target and value. With Fanuc variables
+  // the value is a whole expression ("#1=#2+#3*2"), read to the end of `s`.
   [[nodiscard]] ParamAssign assignment(std::string_view s, std::size_t& pos);
   // A bracketed expression "[...]" at pos.
   [[nodiscard]] double bracketed(std::string_view s, std::size_t& pos);
@@ -90,6 +104,8 @@ class ExprReader {
 
  private:
   double binary(std::string_view s, std::size_t& pos, int level);
+  double operate(std::string_view op, double a, double b) const;
+  double fanuc_function(std::string_view f, std::string_view s, std::size_t& pos);
   double parameter(std::string_view s, std::size_t& pos);
   double function(std::string_view s, std::size_t& pos);
   static double number(std::string_view s, std::size_t& pos);

@@ -88,7 +88,7 @@ std::vector<double> numbers(const std::string& args) {
 bool machine_has_axis(const GcodeOptions& o, int a) {
   switch (o.machine) {
     case MachineKind::Mill3: return a <= Z;
-    case MachineKind::MillRotary: return a <= Z || o.rotary[static_cast<std::size_t>(a - A)];
+    case MachineKind::Mill5: return a <= Z || o.rotary[static_cast<std::size_t>(a - A)];
     case MachineKind::Lathe: return a == X || a == Z;
     case MachineKind::LatheC: return a != A && a != B;
   }

@@ -112,7 +112,7 @@ bool Geometry::stop_due() noexcept {
 
 void Geometry::kernel(std::span<const geom::SweepRef> part) noexcept {
   const std::int64_t t_start = sched::now_ns();
-  solid_.subtract(part, ws_);
+  solid_.subtract(part);
   work_.record(sched::now_ns() - t_start);
   calls_.store(calls_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   sweeps_.store(sweeps_.load(std::memory_order_relaxed) + part.size(), std::memory_order_relaxed);

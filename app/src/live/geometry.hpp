@@ -110,7 +110,6 @@ class Geometry final : public motion::SweepSink {
   geom::LbrSolid& solid_;
   sched::SpscRing<hal::AxisSample>& ring_;
   motion::SampleStream stream_;
-  geom::SubtractWorkspace ws_;
   std::vector<std::int64_t> rx_;
   std::vector<std::uint32_t> weight_;      // 1 + samples folded into ring entry i
   std::vector<std::uint32_t> stamp_;       // per (region, level): sub-batch that counted it

@@ -234,7 +234,7 @@ void LivePipeline::configure() {
   Impl& p = *impl_;
   const Profile& profile = p.profile;
   const hal::LiveConfig& cfg = profile.live;
-  p.tools = std::make_unique<motion::ToolTable>(tool_config(profile), profile.solid.chord_tol_mm, profile.source);
+  p.tools = std::make_unique<motion::ToolTable>(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   if (!p.tools->defines(cfg.tool))
     throw std::runtime_error(profile.source + ": live.tool " + std::to_string(cfg.tool) + " is not in the tool table");
   p.tools->build_all();

@@ -29,7 +29,7 @@ class EmulatorGenerator final : public hal::SampleGenerator {
 std::unique_ptr<hal::Source> make_emulator_source(const Profile& profile, const std::string& arg, double speed) {
   const nc::Toolpath path = arg == "demo" ? demo_toolpath() : load_toolpath(arg, profile);
   for (const nc::Segment& sg : path.segments)
-    if (sg.tool != 0 && !profile.tools.count(sg.tool) && !profile.inserts.count(sg.tool))
+    if (sg.tool != 0 && !profile.tooling.tools.count(sg.tool) && !profile.tooling.inserts.count(sg.tool))
       throw std::runtime_error(path.source + ":" + std::to_string(sg.line) + ": tool " + std::to_string(sg.tool) +
                                " is not in the tool table of " + profile.source);
   return hal::make_generator_source(std::make_unique<EmulatorGenerator>(path, live_emulator_limits(profile)), arg,

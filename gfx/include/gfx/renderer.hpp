@@ -95,6 +95,17 @@ class Renderer {
 
  private:
   struct Gl;
+  // The steps of frame(), in order.
+  void cull(const glm::dmat4& vp, FrameInfo& fi);
+  void rebuild_visible(FrameInfo& fi);
+  void upload_changed(FrameInfo& fi);
+  void upload_path();
+  void draw_stock(const Camera& cam, const glm::dmat4& vp, int w, int h, FrameInfo& fi);
+  void set_scene_uniforms(const Camera& cam, const glm::dmat4& vp);
+  void draw_tools();
+  void draw_path();
+  void draw_hud(int w, int h);
+
   RenderOptions opt_;
   MeshMirror mirror_;
   std::unique_ptr<Gl> gl_;
@@ -108,6 +119,7 @@ class Renderer {
   std::uint64_t version_ = 0;
   int limit_ = 4;
   std::vector<std::uint32_t> upload_idx_;
+  std::vector<char> visible_;  // regions in the view frustum this frame
   FrameInfo last_;
 };
 

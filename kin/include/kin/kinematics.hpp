@@ -15,18 +15,10 @@
 #pragma once
 
 #include "geom/types.hpp"
+#include "nc/machine_kind.hpp"  // nc::MachineKind, the one machine-kind type
 #include "nc/toolpath.hpp"
 
 namespace lbr::kin {
-
-enum class MachineKind : unsigned char {
-  Mill3,  // X Y Z, tool axis +Z
-  Mill5,  // X Y Z + two rotary axes (table-table or head-head)
-  Lathe,  // X Z (+Y), turning tools only; C not used
-  LatheC, // lathe with C spindle positioning and live (milling/drilling) tools
-};
-[[nodiscard]] const char* to_string(MachineKind k) noexcept;  // "mill3", "mill5", "lathe", "lathe-c"
-[[nodiscard]] bool parse_machine_kind(const char* s, MachineKind& out) noexcept;
 
 // Rotary axis arrangement of a mill5 (the first letter is the tilt axis, C the rotary one).
 enum class Rotary : unsigned char {
@@ -47,7 +39,7 @@ enum class Mount : unsigned char {
 };
 
 struct Kinematics {
-  MachineKind kind = MachineKind::Mill3;
+  nc::MachineKind kind = nc::MachineKind::Mill3;
   // mill5
   Rotary rotary = Rotary::TableAC;
   // Table: a point on both rotary axes (where they meet), in the program (G54) frame at

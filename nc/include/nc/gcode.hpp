@@ -19,20 +19,23 @@
 #include <string>
 #include <vector>
 
+#include "nc/machine_kind.hpp"
 #include "nc/toolpath.hpp"
 
 namespace lbr::nc {
 
-// Which axis words a program may use.
-enum class MachineKind : unsigned char {
-  Mill3,       // X Y Z
-  MillRotary,  // X Y Z and the rotary axes of GcodeOptions::rotary ([deg], carried into Segment::end[A..C])
-  Lathe,       // X Z; G7 diameter mode / G8 radius mode apply to X words
-  LatheC,      // X Y Z C (C spindle positioning [deg], live tools); G7 / G8 as Lathe
+// The program syntax the built-in interpreter reads (profile [nc] dialect).
+enum class Dialect : unsigned char {
+  Rs274ngc,  // LinuxCNC's RS274/NGC: O-word subroutines and control flow, #<named> parameters
+  Fanuc,     // ISO/Fanuc: O numbers, M98/M99, G65/G66 macros, IF/GOTO/WHILE (docs/nc-frontend.md#fanuc-dialect)
 };
+
+// "rs274ngc" / "fanuc" (profile [nc] dialect, --dialect): false for any other name.
+[[nodiscard]] bool parse_dialect(const std::string& name, Dialect& out);
 
 struct GcodeOptions {
   MachineKind machine = MachineKind::Mill3;
+  Dialect dialect = Dialect::Rs274ngc;
   std::map<int, double> tool_lengths;    // tool number -> gauge line to tip [mm]; missing = 0
   std::map<int, double> tool_diameters;  // tool number -> diameter [mm]; cutter radius
                                          // compensation (G41/G42 D) in both front ends
@@ -48,8 +51,10 @@ struct GcodeOptions {
   bool diameter_mode = false;  // lathe kinds: G7 (X words are diameters) at program start
   // Directories searched for NAME.ngc when a program calls o<name> that it does not define,
   // after the program's own directory (profile [nc] subroutine_path; LinuxCNC's SUBROUTINE_PATH).
+  // The fanuc dialect looks there for O1234 / O1234.nc when M98 P1234 or G65 P1234 calls a
+  // program that the file does not hold.
   std::vector<std::string> subroutine_path;
-  // MillRotary: which of A, B, C the machine has (a word for a missing one is an error).
+  // Mill5: which of A, B, C the machine has (a word for a missing one is an error).
   std::array<bool, 3> rotary{true, true, true};
   // At most this many blocks are executed (loops included); more is an error, not a hang. 0: no limit.
   long max_blocks = 20000000;

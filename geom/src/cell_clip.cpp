@@ -1,0 +1,209 @@
+// The clip of one cell by the sections of its level (phase C of SubtractEngine::run()):
+// which sections and polygons take part, sections in the air left out, long sections and
+// chain offsets cut down to the region, one Clipper difference, move ids carried over.
+#include <algorithm>
+
+#include "polygon_ops.hpp"
+#include "subtract_engine.hpp"
+
+namespace lbr::geom::detail {
+
+namespace {
+
+// Sections with at least this many vertices are cut to the region before a clip.
+constexpr std::size_t kCutSectionVertices = 64;
+
+// True when some edge of the closed contour has a box that meets b (conservative: the edge
+// may still miss b).
+bool edge_near(const Path& c, const Rect& b) noexcept {
+  for (std::size_t i = 0, j = c.size() - 1; i < c.size(); j = i++) {
+    const Point& p = c[i];
+    const Point& q = c[j];
+    if (std::max(p.X, q.X) < b.x0 || std::min(p.X, q.X) > b.x1 || std::max(p.Y, q.Y) < b.y0 || std::min(p.Y, q.Y) > b.y1)
+      continue;
+    return true;
+  }
+  return false;
+}
+
+
+// The sections whose box meets the cell's content (ws.selected) and the cell's polygons
+// whose box meets those sections (ws.touched); false when either is empty.
+bool select_for_cell(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws) {
+  ws.selected.clear();
+  Rect clipbox;
+  for (std::uint32_t k = 0; k < ls.paths.size(); ++k) {
+    if (ls.box[k].intersects(cell.bbox)) {
+      ws.selected.push_back(k);
+      clipbox.add(ls.box[k]);
+    }
+  }
+  if (ws.selected.empty()) return false;
+  ws.touched.clear();
+  for (std::uint32_t p = 0; p < cell.polys.size(); ++p)
+    if (cell.polys[p].bbox.intersects(clipbox)) ws.touched.push_back(p);
+  return !ws.touched.empty();
+}
+
+// Sections in the air: when no edge of the material comes near a section's box, the box
+// lies wholly inside or wholly outside the material, and one point decides which. A
+// section outside removes nothing and leaves the clip (the shank of a finishing tool over
+// already cleared levels). False when none is left: nothing changes.
+bool drop_sections_in_air(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws, SubtractStats& stats) {
+  std::size_t kept = 0;
+  for (std::uint32_t k : ws.selected) {
+    const Rect& b = ls.box[k];
+    bool near = false, inside = false;
+    const Point centre{b.x0 + (b.x1 - b.x0) / 2, b.y0 + (b.y1 - b.y0) / 2};
+    for (std::uint32_t p : ws.touched) {
+      const Polygon& poly = cell.polys[p];
+      if (!poly.bbox.intersects(b)) continue;
+      near = edge_near(poly.outer.pts, b);
+      for (std::size_t h = 0; !near && h < poly.holes.size(); ++h) near = edge_near(poly.holes[h].pts, b);
+      if (near) break;
+      if (ClipperLib::PointInPolygon(centre, poly.outer.pts) != 0) {
+        inside = true;
+        for (const Contour& h : poly.holes)
+          if (ClipperLib::PointInPolygon(centre, h.pts) != 0) inside = false;
+        if (inside) break;
+      }
+    }
+    if (near || inside) ws.selected[kept++] = k;
+    else ++stats.sections_in_air;
+  }
+  ws.selected.resize(kept);
+  return kept > 0;
+}
+
+// A difference that removes no more than the rounding of intersection points to the unit
+// grid can account for (half a unit along the touched perimeter) is noise, e.g. a second
+// pass along the same path: the caller keeps the old polygons, vertex for vertex.
+bool removes_only_noise(const Cell& cell, const SubtractWorkspace& ws) {
+  double before = 0.0, after = 0.0, perimeter = 0.0;
+  for (std::uint32_t p : ws.touched) {
+    const Polygon& old = cell.polys[p];
+    before += ClipperLib::Area(old.outer.pts);
+    perimeter += detail::perimeter(old.outer.pts);
+    for (const Contour& h : old.holes) {
+      before += ClipperLib::Area(h.pts);
+      perimeter += detail::perimeter(h.pts);
+    }
+  }
+  for (const Polygon& poly : ws.fresh) {
+    after += ClipperLib::Area(poly.outer.pts);
+    for (const Contour& h : poly.holes) after += ClipperLib::Area(h.pts);
+  }
+  return before - after <= 0.5 * perimeter;
+}
+
+// Carries the move id over to the contours of ws.fresh that came out unchanged; a new or
+// changed contour takes the latest move among the sections that overlap it. True when
+// some contour changed.
+bool inherit_move_ids(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws) {
+  bool changed = ws.fresh.size() != ws.touched.size();
+  auto inherit = [&](Contour& out, const Rect& box) {
+    for (std::uint32_t p : ws.touched) {
+      const Polygon& old = cell.polys[p];
+      if (old.bbox == box && same_cycle(old.outer.pts, out.pts)) {
+        out.cut_by = old.outer.cut_by;
+        return;
+      }
+      for (const Contour& h : old.holes) {
+        if (h.pts.size() == out.pts.size() && same_cycle(h.pts, out.pts)) {
+          out.cut_by = h.cut_by;
+          return;
+        }
+      }
+    }
+    changed = true;
+    MoveId id = 0;
+    for (std::uint32_t k : ws.selected)
+      if (ls.box[k].intersects(box)) id = std::max(id, ls.id[k]);
+    if (id == 0)
+      for (std::uint32_t k : ws.selected) id = std::max(id, ls.id[k]);
+    out.cut_by = id;
+  };
+  for (Polygon& poly : ws.fresh) {
+    inherit(poly.outer, poly.bbox);
+    for (Contour& h : poly.holes) inherit(h, bounds_of(h.pts));
+  }
+  return changed;
+}
+
+// The cell's polygons with the touched ones replaced by ws.fresh (untouched first).
+void replace_touched(Cell& cell, SubtractWorkspace& ws) {
+  ws.kept.clear();
+  std::size_t t = 0;
+  for (std::uint32_t p = 0; p < cell.polys.size(); ++p) {
+    if (t < ws.touched.size() && ws.touched[t] == p) {
+      ++t;
+      continue;
+    }
+    ws.kept.push_back(std::move(cell.polys[p]));
+  }
+  for (Polygon& poly : ws.fresh) ws.kept.push_back(std::move(poly));
+  cell.polys.swap(ws.kept);
+}
+
+}  // namespace
+
+Rect SubtractEngine::grown_region_rect(int region) const noexcept {
+  const Rect rr = s_.region_rect(region);
+  const Coord g = static_cast<Coord>(kUnitsPerMm);
+  return Rect{rr.x0 - g, rr.y0 - g, rr.x1 + g, rr.y1 + g};
+}
+
+// The selected sections as clip paths. A chain enters as its offset's piece for the
+// region; a long section that reaches well beyond the region (a joined outline runs along
+// a whole pass) is cut down to the region grown by 1 mm first, so that the clip carries
+// only the nearby edges (the cut keeps the path inside the grown region, where the cell lies).
+void SubtractEngine::add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const {
+  ClipperLib::Clipper& c = ws.clipper;
+  const Rect grown = grown_region_rect(region);
+  for (std::uint32_t k : ws.selected) {
+    if (ls.chain[k] != kNoChain) {
+      c.AddPaths(offset_piece(sh, ls.chain[k], region, ws), ClipperLib::ptClip, true);
+    } else if (contains(grown, ls.box[k]) || ls.paths[k].size() < kCutSectionVertices) {
+      c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
+    } else {
+      cut_to_rect(ls.paths[k], grown, ws.cut, ws.cut_tmp);
+      if (ws.cut.size() >= 3) c.AddPath(ws.cut, ClipperLib::ptClip, true);
+    }
+  }
+}
+
+// Clips one cell with the level's sections; true when the cell changed.
+bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
+                         SubtractStats& stats) {
+  const std::size_t ci = static_cast<std::size_t>(region) * s_.levels_ + level;
+  Cell& cell = s_.cells_[ci];
+  if (!cell.bbox.intersects(ls.all)) return false;
+  ++stats.cells_tested;
+  if (!select_for_cell(cell, ls, ws) || !drop_sections_in_air(cell, ls, ws, stats)) return false;
+
+  ClipperLib::Clipper& c = ws.clipper;
+  c.Clear();
+  c.StrictlySimple(s_.spec_.strictly_simple);
+  for (std::uint32_t p : ws.touched) {
+    c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
+    for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
+  }
+  add_clip_paths(region, ls, sh, ws);
+  ws.tree.Clear();
+  c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  ++stats.cells_clipped;
+  ws.fresh.clear();
+  append_polygons(ws.tree, ws.fresh);
+  if (removes_only_noise(cell, ws) || !inherit_move_ids(cell, ls, ws)) return false;
+
+  replace_touched(cell, ws);
+  refresh_cell(cell);
+  cell.last_cut = 0;
+  for (std::uint32_t k : ws.selected) cell.last_cut = std::max(cell.last_cut, ls.id[k]);
+  ++cell.version;
+  s_.dirty_flag_[ci] = 1;
+  ++stats.cells_changed;
+  return true;
+}
+
+}  // namespace lbr::geom::detail

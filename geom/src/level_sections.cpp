@@ -1,0 +1,229 @@
+// The sections of one level for one batch: joined outlines of vertical runs, single
+// sections trimmed where the previous one covers them, tilted sections, chain offsets and
+// lathe regions; and the chain offsets themselves with their pieces cut to regions.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "chain_outline.hpp"
+#include "polygon_ops.hpp"
+#include "subtract_engine.hpp"
+
+namespace lbr::geom::detail {
+
+// Builds offset `o` of the prepared batch. Offset vertices lie on radius r + tol/4 and
+// chords sag at most tol/2 inside it, so the boundary stays within ±tol/4 of the exact one.
+void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
+  ++stats.chain_offsets;
+  const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
+  SubtractShared::Offset& off = sh.offsets[o];
+  const double tol = c.shape->chord_tol_mm;
+  ClipperLib::ClipperOffset co(2.0, 0.5 * tol * kUnitsPerMm);
+  co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
+  off.paths.clear();
+  co.Execute(off.paths, (sh.offset_keys[o].r + 0.25 * tol) * kUnitsPerMm);
+}
+
+void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
+                                 SubtractStats& stats) const {
+  const double zc = s_.level_z_mm(level);
+  ws.prev_tilted_valid = false;
+  for (Path& p : ls.paths) ws.scratch.spare.push_back(std::move(p));  // keep the buffers
+  ls.paths.clear();
+  ls.box.clear();
+  ls.id.clear();
+  ls.chain.clear();
+  ls.chain_offset.assign(sh.chain_count, kNoChain);
+  ls.all = Rect{};
+  ls.ix0 = ls.iy0 = 0;
+  ls.ix1 = ls.iy1 = -1;
+  for (const auto& run : sh.runs) build_run_sections(zc, run, sh, ws, ls, stats);
+  ls.chain.assign(ls.paths.size(), kNoChain);
+  add_chain_sections(level, sh, ls);
+  add_lathe_sections(zc, sh, ls);
+  stats.sections += ls.paths.size();
+  if (ls.paths.empty() || !ls.all.intersects(s_.xy_)) return;
+  ls.ix0 = interval_of(s_.xs_, ls.all.x0);
+  ls.ix1 = interval_of(s_.xs_, ls.all.x1);
+  ls.iy0 = interval_of(s_.ys_, ls.all.y0);
+  ls.iy1 = interval_of(s_.ys_, ls.all.y1);
+}
+
+// Chains: one entry for the whole offset (outer contours and holes); a clip adds its piece
+// cut to the region (SubtractShared::Offset).
+void SubtractEngine::add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls) {
+  for (std::size_t ci = 0; ci < sh.chain_count; ++ci) {
+    const std::uint32_t o = sh.offset_of[static_cast<std::size_t>(level - sh.lb) * sh.chain_count + ci];
+    if (o == kNoChain) continue;  // (the offset itself may still be in the making)
+    ls.chain_offset[ci] = o;
+    ls.paths.emplace_back();
+    ls.box.push_back(sh.offsets[o].box);
+    ls.id.push_back(sh.chains[ci].id);
+    ls.chain.push_back(o);
+    ls.all.add(sh.offsets[o].box);
+  }
+}
+
+// Turning moves: the union of their revolved regions on this level is one region, the
+// smallest r_min (external) and the largest r_max (internal); it takes the latest move id
+// among them.
+void SubtractEngine::add_lathe_sections(double zc, const SubtractShared& sh, LevelSections& ls) const {
+  if (sh.lathe.empty()) return;
+  double r_out = INFINITY, r_in = -INFINITY, tol = s_.spec_.chord_tol_mm;
+  MoveId id_out = 0, id_in = 0;
+  for (std::size_t si = 0; si < sh.lathe.size(); ++si) {
+    const LatheSweep& lw = sh.lathe[si];
+    double lo = 0, hi = 0;
+    if (zc < lw.z_min() || zc > lw.z_max() || !lw.interval(zc, lo, hi)) continue;
+    tol = lw.chord_tol_mm();
+    if (lw.internal()) {
+      if (hi > r_in) r_in = hi;
+      id_in = std::max(id_in, sh.lathe_id[si]);
+    } else {
+      if (lo < r_out) r_out = lo;
+      id_out = std::max(id_out, sh.lathe_id[si]);
+    }
+  }
+  for (int internal = 0; internal < 2; ++internal) {
+    const double r = internal ? r_in : r_out;
+    if (!std::isfinite(r)) continue;
+    const std::size_t before = ls.paths.size();
+    LatheSweep::removed_region(r, internal != 0, tol, s_.xy_, ls.paths);
+    for (std::size_t k = before; k < ls.paths.size(); ++k) {
+      ls.box.push_back(bounds_of(ls.paths[k]));
+      ls.id.push_back(internal ? id_in : id_out);
+      ls.chain.push_back(kNoChain);
+      ls.all.add(ls.box.back());
+    }
+  }
+}
+
+// The sections of one run of sweeps on plane zc: consecutive moves whose sections share
+// their joint disk become one outline (chain_outline.hpp); the others are emitted one by
+// one, trimmed where the previous vertical section covers them (trim_covered()).
+void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
+                                  SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const {
+  Capsule prev_core;  // inside the last single vertical section of this run (trim_covered())
+  auto push_boxes = [&](std::size_t before, MoveId id) {
+    for (std::size_t k = before; k < ls.paths.size(); ++k) {
+      ls.box.push_back(bounds_of(ls.paths[k]));
+      ls.id.push_back(id);
+      ls.all.add(ls.box.back());
+    }
+  };
+  std::uint32_t si = run.first;
+  while (si < run.second) {
+    const Sweep& sw = sh.sweeps[si];
+    if (zc < sw.z_min() || zc > sw.z_max()) {
+      ++si;
+      continue;
+    }
+    // Joined outline from si, when si and at least the next move share their joint disk.
+    if (run.second - si >= 2) {
+      // One angle grid along the run: the tool's full radius sets it. Even, so that a
+      // stadium's caps are exact half turns (chain_outline.cpp, chord_is_covered()).
+      const int grid = (Sweep::circle_segments(sw.shape().radius(), sw.shape().chord_tol_mm) + 1) / 2 * 2;
+      if (ws.caps.size() < run.second - si) ws.caps.resize(run.second - si);
+      std::size_t count = 0;
+      while (si + count < run.second && sh.sweeps[si + count].section_caps(zc, grid, ws.scratch, ws.caps[count]) &&
+             (count == 0 || (ws.caps[count - 1].c1.x == ws.caps[count].c0.x && ws.caps[count - 1].c1.y == ws.caps[count].c0.y &&
+                             ws.caps[count - 1].rho1 == ws.caps[count].rho0)))
+        ++count;
+      if (count >= 2) {
+        const std::size_t before = ls.paths.size();
+        detail::append_outline(std::span<const MoveCaps>(ws.caps.data(), count), grid, ws.scratch.unit_circle(grid),
+                               ws.outline, ls.paths, ws.scratch.spare);
+        MoveId id = 0;
+        for (std::size_t k = 0; k < count; ++k) id = std::max(id, sh.sweep_id[si + k]);
+        push_boxes(before, id);
+        stats.sections_joined += count;
+        prev_core = Capsule{};
+        si += static_cast<std::uint32_t>(count);
+        continue;
+      }
+    }
+    const std::size_t before = ls.paths.size();
+    sw.section(zc, ls.paths, ws.scratch);
+    // Consecutive moves overlap: the vertices of this section inside the previous vertical
+    // section's capsule add edges to the clip but remove nothing more (trim_covered()).
+    if (sw.vertical() && ls.paths.size() == before + 1) {
+      if (prev_core.valid()) {
+        const std::size_t vertices = ls.paths.back().size();
+        if (!trim_covered(ls.paths.back(), prev_core, ws.trim_flags)) {
+          ls.paths.pop_back();
+          ++stats.sections_trimmed;
+        } else if (ls.paths.back().size() != vertices) {
+          ++stats.sections_trimmed;
+        }
+      }
+      if (ws.scratch.core.valid()) prev_core = ws.scratch.core;
+    } else if (!sw.vertical()) {
+      trim_tilted(si, before, sh, ws, ls, stats);
+    }
+    push_boxes(before, sh.sweep_id[si]);
+    ++si;
+  }
+}
+
+// A tilted move's sections (one per sub-step) on a level overlap the previous sub-step's and
+// the previous tilted move's as much as vertical ones do: each is trimmed by the previous
+// one as it was before its own trimming (convex; trim_covered() with a polygon). Any
+// untrimmed section of this level is a valid cover (what trimming took from it lies in its
+// own cover, which is removed in the same difference); the previous move's is the useful one.
+void SubtractEngine::trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
+                           LevelSections& ls, SubtractStats& stats) const {
+  const Sweep& sw = sh.sweeps[si];
+  bool covered = ws.prev_tilted_valid && ws.prev_tilted_sweep + 1 == si &&
+                 &sh.sweeps[si - 1].shape() == &sw.shape() && sh.sweeps[si - 1].to().tip == sw.from().tip;
+  std::size_t w = before;
+  for (std::size_t k = before; k < ls.paths.size(); ++k) {
+    ws.tilted_next = ls.paths[k];
+    bool keep = true;
+    if (covered) {
+      const std::size_t vertices = ls.paths[k].size();
+      keep = trim_covered(ls.paths[k], ws.prev_tilted, ws.trim_flags);
+      if (!keep || ls.paths[k].size() != vertices) ++stats.sections_trimmed;
+    }
+    ws.prev_tilted.swap(ws.tilted_next);
+    ws.prev_tilted_valid = covered = true;
+    ws.prev_tilted_sweep = si;
+    if (!keep) {
+      ws.scratch.spare.push_back(std::move(ls.paths[k]));
+      continue;
+    }
+    if (w != k) ls.paths[w] = std::move(ls.paths[k]);
+    ++w;
+  }
+  ls.paths.resize(w);
+}
+
+// The chain offset `o` cut to `region` (grown by 1 mm); the first thread that needs a piece
+// cuts it, one that needs it meanwhile waits (a cut takes microseconds).
+const Paths& SubtractEngine::offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const {
+  static const Paths kNone;
+  SubtractShared::Offset& off = sh.offsets[o];
+  const int ix = region % s_.spec_.regions_x, iy = region / s_.spec_.regions_x;
+  // A cell can touch the box on its edge from the region beside the box's first one: the
+  // offset covers none of its area there.
+  if (ix < off.ix0 || ix > off.ix1 || iy < off.iy0 || iy > off.iy1) return kNone;
+  const Rect rr = grown_region_rect(region);
+  if (contains(rr, off.box)) return off.paths;  // wholly inside: nothing to cut
+  const std::size_t i = static_cast<std::size_t>((iy - off.iy0) * (off.ix1 - off.ix0 + 1) + (ix - off.ix0));
+  std::atomic_ref<std::uint8_t> state(off.state[i]);
+  std::uint8_t s = state.load(std::memory_order_acquire);
+  if (s == 0 && state.compare_exchange_strong(s, 1, std::memory_order_acq_rel)) {
+    Paths& out = off.cut[i];
+    out.clear();
+    ClipperLib::Clipper& k = ws.rect_clipper;
+    k.Clear();
+    k.AddPaths(off.paths, ClipperLib::ptSubject, true);
+    k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
+    k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+    state.store(2, std::memory_order_release);
+  } else {
+    while (state.load(std::memory_order_acquire) != 2) cpu_relax();
+  }
+  return off.cut[i];
+}
+
+}  // namespace lbr::geom::detail

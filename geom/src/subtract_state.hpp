@@ -1,0 +1,122 @@
+// Private: the state of one subtraction — the prepared batch, what its threads share, and
+// each thread's reusable buffers. Only geom/ sees these; callers use LbrSolid::subtract()
+// or geom::ParallelSubtractor (docs/architecture.md, "Kernel").
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include "geom/lbr_solid.hpp"
+
+namespace lbr::geom::detail {
+
+inline constexpr std::uint32_t kNoChain = 0xFFFFFFFFu;
+
+// One step of a thread's wait for another's (a few microseconds at most).
+inline void cpu_relax() noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
+// The sections of one level for one batch, built by one thread and read by all.
+struct LevelSections {
+  Paths paths;                        // convex sections, lathe regions; empty for a chain
+  std::vector<Rect> box;              // bounding boxes
+  std::vector<MoveId> id;             // move ids
+  std::vector<std::uint32_t> chain;   // offset index (SubtractShared) of a chain's entry, else ~0
+  std::vector<std::uint32_t> chain_offset;  // per chain: its offset on this level, or ~0
+  Rect all;                           // union of the boxes
+  int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // regions that the boxes reach
+  std::vector<std::uint8_t> same_cell_below;  // per region: same start as the level below
+  std::vector<std::uint32_t> cost;            // per region: the cell's vertices before the batch
+  [[nodiscard]] bool empty() const noexcept { return ix1 < ix0 || iy1 < iy0; }
+};
+
+// State that the threads of one SubtractEngine::run() share. SubtractEngine::prepare()
+// fills the batch part on one thread; in run() each part is written in one phase and read
+// in the next (the caller's barrier orders them), except the offsets' region pieces, which
+// the first clip that needs one cuts (a per-piece state orders it).
+struct SubtractShared {
+  // --- the batch, prepared once (read only while the threads run) ---
+  std::vector<SweepRef> merged;   // the batch after merging collinear runs
+  std::vector<Sweep> sweeps;      // one per merged milling move
+  std::vector<MoveId> sweep_id;   // their move ids
+  // Runs of consecutive sweeps [first, last) of one tool with a vertical axis along a
+  // continuous path: on each level their sections are joined into outlines where they can.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
+  std::vector<LatheSweep> lathe;  // one per merged turning move
+  std::vector<MoveId> lathe_id;
+  // Runs of at least three consecutive horizontal moves of one tool with a vertical axis at
+  // one height: their section on a level is the polyline offset by the tool radius there,
+  // computed once per distinct radius instead of one stadium per move.
+  struct Chain {
+    const CutterShape* shape = nullptr;
+    double z = 0.0;            // tip height [mm]
+    Path pts;                  // tip positions [units]
+    MoveId id = 0;             // largest move id of the run
+  };
+  std::vector<Chain> chains;
+  std::size_t chain_count = 0;  // chains in use (the vector keeps its buffers)
+  struct OffsetKey {
+    std::uint32_t chain;
+    double r;
+  };
+  std::vector<OffsetKey> offset_keys;      // the batch's distinct (chain, radius), in order
+  std::vector<std::uint32_t> offset_of;    // per (level - lb, chain): index into offset_keys, or ~0
+  int lb = 0, le = 0;                      // the levels the batch reaches: [lb, le)
+  bool offsets_ready = false;              // the offsets' paths are built (during the batch before)
+
+  // --- built by the threads ---
+  std::vector<LevelSections> levels;    // per level the batch reaches, reused between batches
+  std::vector<std::uint8_t> outcome;    // per (level - lb, region): the clip changed the cell
+  // A chain offset by one radius (one per distinct (chain, radius) of the batch), and its
+  // pieces cut to the regions its box reaches (rectangles grown by 1 mm), so that a clip
+  // carries only the nearby edges. A piece is cut when a clip first needs it.
+  struct Offset {
+    Paths paths;
+    Rect box;
+    int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;
+    std::vector<Paths> cut;            // (iy - iy0) * (ix1 - ix0 + 1) + (ix - ix0)
+    std::vector<std::uint8_t> state;   // per piece: 0 not cut, 1 being cut, 2 cut (atomic_ref)
+  };
+  std::vector<Offset> offsets;
+  std::atomic<std::size_t> next[3] = {};  // work counters: phase A, phase C, next batch's offsets
+  std::atomic<std::uint8_t> ahead_ready{0};  // the next batch is prepared (SubtractAhead)
+};
+
+// The batch after the current one, prepared during the current one's clips by one thread
+// (`prepare`: SubtractEngine::prepare() into `shared`, and whatever the caller keeps with
+// it); its chain offsets, which depend on the batch only, are then built by the threads
+// between their clips. The caller sets shared->offsets_ready once run() has returned.
+struct SubtractAhead {
+  SubtractShared* shared = nullptr;
+  std::function<void()> prepare;
+};
+
+// Reusable buffers for the subtraction; one per thread that runs it. Grows to the largest
+// batch seen and is then reused without further allocation of its own.
+struct SubtractWorkspace {
+  ClipperLib::Clipper clipper;
+  ClipperLib::Clipper rect_clipper;  // cuts chain offsets to regions
+  ClipperLib::PolyTree tree;
+  SectionScratch scratch;
+  std::vector<MoveCaps> caps;                 // one per move of a joined run
+  std::vector<SectionScratch::P2> outline;    // a joined run's vertices before rounding
+  Path cut, cut_tmp;                          // a long section cut to a region
+  Path prev_tilted, tilted_next;              // the last tilted section of a level, untrimmed
+  bool prev_tilted_valid = false;
+  std::uint32_t prev_tilted_sweep = 0;
+  std::vector<std::uint8_t> trim_flags;
+  std::vector<int> source;          // per (level - lb, region): the level whose result it takes
+  std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip
+  std::vector<std::pair<std::size_t, std::uint32_t>> job_cost;  // (estimate, job) for ordering
+  SubtractShared own;               // for a subtraction on one thread
+  std::vector<std::uint32_t> selected, touched;
+  std::vector<Polygon> fresh, kept;
+};
+
+}  // namespace lbr::geom::detail
