@@ -38,6 +38,7 @@ TEST(ToolpathWarnings, FeedMovesWithoutAToolAreCountedOnceWithTheFirstLine) {
   const auto w = app::toolpath_warnings(p);
   ASSERT_EQ(w.size(), 1u);
   EXPECT_EQ(w[0].rfind("spiral.ngc:4: 3 feed moves run with no tool loaded (tool 0)", 0), 0u) << w[0];
+  EXPECT_NE(w[0].find("--start-tool N (profile: [nc] start_tool)"), std::string::npos) << w[0];
 }
 
 TEST(ToolpathWarnings, AProgramThatLoadsAToolIsQuiet) {

@@ -84,8 +84,26 @@ endif()
 # Errors name file, line and word.
 file(WRITE "${OUT}/bad.ngc" "G21 G90\nG0 X1\nG41 D1 X2\n")
 execute_process(COMMAND "${LBRSIM}" batch --quiet --program "${OUT}/bad.ngc" --out "${OUT}/c" RESULT_VARIABLE rc ERROR_VARIABLE err)
-if(rc EQUAL 0 OR NOT err MATCHES "bad.ngc:3: unsupported word 'G41' \\(cutter radius compensation; use --interpreter rs274\\)")
+if(rc EQUAL 0 OR NOT err MATCHES "bad.ngc:3: the cutter compensation entry move \\(1 mm in the plane\\) is not longer than the tool radius \\(5 mm\\)")
   message(FATAL_ERROR "bad G-code not reported as expected (rc ${rc}): ${err}")
+endif()
+
+# --start-tool: a program without M6 on a machine whose spindle already holds tool 1.
+file(WRITE "${OUT}/notool.ngc" "G21 G90 G43\nG0 X30 Y30 Z5\nG1 Z-2 F400\nG1 X50\nM2\n")
+execute_process(COMMAND "${LBRSIM}" batch --level-spacing 0.5 --program "${OUT}/notool.ngc" --out "${OUT}/t0"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+file(READ "${OUT}/t0/metrics.json" m)
+string(JSON removed0 GET "${m}" removed_volume_mm3)
+if(NOT rc EQUAL 0 OR NOT removed0 EQUAL 0 OR NOT "${out}${err}" MATCHES "notool.ngc:3: 2 feed moves run with no tool loaded.*--start-tool N")
+  message(FATAL_ERROR "tool-0 program: rc ${rc}, removed ${removed0}, expected the --start-tool warning: ${out} ${err}")
+endif()
+execute_process(COMMAND "${LBRSIM}" batch --quiet --level-spacing 0.5 --start-tool 1 --program "${OUT}/notool.ngc"
+                --out "${OUT}/t1" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+file(READ "${OUT}/t1/metrics.json" m)
+string(JSON removed1 GET "${m}" removed_volume_mm3)
+# A 10 mm tool 2 mm deep along 20 mm plus the plunge: ~ 20 x 10 x 2 + pi 25 x 2 = 557 mm3.
+if(NOT rc EQUAL 0 OR removed1 LESS 500 OR removed1 GREATER 620 OR "${out}${err}" MATCHES "no tool loaded")
+  message(FATAL_ERROR "--start-tool 1: rc ${rc}, removed ${removed1} mm3 outside [500, 620]: ${out} ${err}")
 endif()
 
 find_program(RS274 rs274)

@@ -238,9 +238,11 @@ TEST(NgcDefects, RotaryWordsForMissingAxesAreRefused) {
   EXPECT_DOUBLE_EQ(ends(run("G0 A10 C5\n", o)).back()[C], 5.0);
 }
 
-TEST(NgcDefects, SpindleSynchronisedMotionIsRefusedWithoutSuggestingRs274) {
-  EXPECT_EQ(error_of("G76 P1 Z-10 I-1 J0.5 K1\n"),
-            "t.ngc:1: unsupported word 'G76' (spindle-synchronised motion: the tool path carries no spindle angle)");
+TEST(NgcDefects, SpindleSynchronisedMotionNeedsASpindleSpeed) {
+  // G33/G33.1/G76 run in both front ends now (tests/nc_ngc_motion_test.cpp); without S they
+  // are refused with the reason, not with a suggestion to use rs274.
+  EXPECT_EQ(error_of("G18\nG76 P1 Z-10 I-1 J0.5 K1\n"),
+            "t.ngc:2: 'G76' needs a spindle speed S > 0 (spindle-synchronised motion)");
 }
 
 TEST(NgcDefects, FeedPerRevolution) {

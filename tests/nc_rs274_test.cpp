@@ -100,36 +100,7 @@ GcodeOptions recorded_options(double chord_tol_mm) {
   return o;
 }
 
-// Every vertex of `a` lies within tol of `b`'s polyline, visited in order. Returns the
-// largest distance seen, or +inf when a vertex has no match.
-double directed_distance(const Toolpath& a, const Toolpath& b, double tol) {
-  std::size_t j = 0;
-  AxisVector bfrom = b.start;
-  double worst = 0.0;
-  for (const Segment& s : a.segments) {
-    if (s.kind != SegmentKind::Rapid && s.kind != SegmentKind::Feed) continue;
-    std::size_t k = j;
-    AxisVector from = bfrom;
-    bool found = false;
-    for (; k < b.segments.size(); ++k) {
-      const double d = lbr::test::axis_dist_to_segment(s.end, from, b.segments[k].end);
-      if (d <= tol) {
-        worst = std::max(worst, d);
-        found = true;
-        break;
-      }
-      from = b.segments[k].end;
-    }
-    if (!found) {
-      ADD_FAILURE() << "vertex of line " << s.line << " (" << s.end[X] << ", " << s.end[Y] << ", " << s.end[Z]
-                    << ") is not on the other path";
-      return INFINITY;
-    }
-    j = k;
-    bfrom = from;
-  }
-  return worst;
-}
+using lbr::test::directed_distance;
 
 struct Event {
   SegmentKind kind;
@@ -192,7 +163,10 @@ TEST(Rs274Canon, RecordedOutputMatchesTheBuiltInInterpreter) {
 TEST(Rs274Canon, UnrepresentableCommandsAreErrors) {
   EXPECT_EQ(error_of_canon("    1 N3     STRAIGHT_PROBE(0.0000, 0.0000, -5.0000, 0.0000, 0.0000, 0.0000, 0)\n"),
             "p.ngc:3: rs274: canonical command STRAIGHT_PROBE is not supported");
-  EXPECT_EQ(error_of_canon("    1 N4     SET_FEED_MODE(0, 1)\n"), "p.ngc:4: rs274: feed per revolution (G95) is not supported");
+  EXPECT_EQ(error_of_canon("    1 N4     SET_FEED_MODE(0, 1)\n    2 N4     SET_FEED_RATE(0.1000)\n"
+                           "    3 N4     STRAIGHT_FEED(1.0000, 0.0000, 0.0000, 0.0000, 0.0000, 0.0000)\n"),
+            "p.ngc:4: rs274: STRAIGHT_FEED per revolution or synchronised with the spindle needs a spindle speed S > 0 "
+            "(at X0 in G96: D)");
   EXPECT_EQ(error_of_canon("    1 N5     SET_XY_ROTATION(30.0000)\n"), "p.ngc:5: rs274: XY rotation (G10 L2 R) is not supported");
   EXPECT_EQ(error_of_canon("    1 N6     STRAIGHT_FEED(1.0000, 0.0000)\n"),
             "p.ngc:6: rs274: canonical command STRAIGHT_FEED has 2 numbers, expected 6");

@@ -1,6 +1,8 @@
 // Helpers shared by the nc tests.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -31,6 +33,37 @@ inline double axis_dist_to_segment(const nc::AxisVector& p, const nc::AxisVector
     d2 += q * q;
   }
   return std::sqrt(d2);
+}
+
+// Every vertex of `a` lies within tol of `b`'s polyline, visited in order. Returns the
+// largest distance seen, or +inf when a vertex has no match.
+inline double directed_distance(const nc::Toolpath& a, const nc::Toolpath& b, double tol) {
+  std::size_t j = 0;
+  nc::AxisVector bfrom = b.start;
+  double worst = 0.0;
+  for (const nc::Segment& s : a.segments) {
+    if (s.kind != nc::SegmentKind::Rapid && s.kind != nc::SegmentKind::Feed) continue;
+    std::size_t k = j;
+    nc::AxisVector from = bfrom;
+    bool found = false;
+    for (; k < b.segments.size(); ++k) {
+      const double d = axis_dist_to_segment(s.end, from, b.segments[k].end);
+      if (d <= tol) {
+        worst = std::max(worst, d);
+        found = true;
+        break;
+      }
+      from = b.segments[k].end;
+    }
+    if (!found) {
+      ADD_FAILURE() << "vertex of line " << s.line << " (" << s.end[nc::X] << ", " << s.end[nc::Y] << ", " << s.end[nc::Z]
+                    << ") is not on the other path";
+      return INFINITY;
+    }
+    j = k;
+    bfrom = from;
+  }
+  return worst;
 }
 
 // The built-in interpreter on a program text (named t.ngc in messages).

@@ -87,7 +87,7 @@ std::vector<std::string> toolpath_warnings(const nc::Toolpath& path) {
   if (untooled > 0)
     out.push_back(name + ":" + std::to_string(first_line) + ": " + std::to_string(untooled) +
                   " feed moves run with no tool loaded (tool 0) and cut nothing; load one with T.. M6, "
-                  "or set [nc] start_tool in the profile when the spindle already holds a tool");
+                  "or give --start-tool N (profile: [nc] start_tool) when the spindle already holds a tool");
   return out;
 }
 

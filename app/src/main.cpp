@@ -41,6 +41,7 @@ struct BatchOptions {
   std::vector<std::string> tools;
   double level_spacing = 0.0;
   int threads = -1;
+  int start_tool = -1;  // --start-tool (-1: the profile's [nc] start_tool)
   bool quiet = false;
   bool sampled = false;
   // rendering (gfx/)
@@ -62,7 +63,15 @@ struct ViewCliOptions {
 struct EmulateOptions {
   std::string program, profile, period, out = "samples.csv", interpreter = "builtin";
   std::string dialect;
+  int start_tool = -1;  // --start-tool (-1: the profile's [nc] start_tool)
 };
+
+// --start-tool N: the tool in the spindle at program start (overrides [nc] start_tool).
+void add_start_tool_option(CLI::App* c, int& start_tool) {
+  c->add_option("--start-tool", start_tool,
+                "Tool in the spindle at program start (0 = empty; default: the profile's [nc] start_tool)")
+      ->check(CLI::Range(0, 99999));
+}
 
 // --dialect NAME (rs274ngc, fanuc): the built-in interpreter's program syntax for this run.
 void add_dialect_option(CLI::App* c, std::string& dialect) {
@@ -106,6 +115,7 @@ int run_emulate_command(const EmulateOptions& o) {
   app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
   if (!o.period.empty()) profile.machine.sample_period_ms = parse_period_ms(o.period);
   apply_dialect(profile, o.dialect);
+  if (o.start_tool >= 0) profile.nc.start_tool = o.start_tool;
   const nc::Toolpath path = app::load_toolpath(o.program, profile, interpreter_of(o.interpreter));
   nc::Emulator em(path, app::emulator_limits(profile));
   const std::uint64_t n = app::write_samples_csv(o.out, em);
@@ -182,6 +192,7 @@ app::Profile batch_profile(const BatchOptions& o) {
   if (!o.regions.empty()) app::apply_regions(profile, o.regions, "--regions");
   if (o.threads >= 0) profile.threads = o.threads;
   apply_dialect(profile, o.dialect);
+  if (o.start_tool >= 0) profile.nc.start_tool = o.start_tool;
   return profile;
 }
 
@@ -566,6 +577,7 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
   add_dialect_option(batch, b.dialect);
+  add_start_tool_option(batch, b.start_tool);
   batch->add_flag("--sampled", b.sampled,
                   "Run the kernel on the machine emulator's sampled stream (as live mode sees it) instead of the "
                   "interpreted segments");
@@ -601,6 +613,7 @@ CLI::App* add_view_command(CLI::App& cli, BatchOptions& vb, ViewCliOptions& vv) 
       ->capture_default_str();
   add_dialect_option(view, vb.dialect);
   view->add_option("--profile", vb.profile, "Machine profile (TOML)");
+  add_start_tool_option(view, vb.start_tool);
   view->add_option("--stock", vb.stock, "Override the stock (as for batch)");
   view->add_option("--tool", vb.tools, "Add or override a tool (as for batch)")->take_all();
   view->add_option("--level-spacing", vb.level_spacing, "Level spacing Δ [mm]")->check(CLI::Range(0.001, 1000.0));
@@ -669,6 +682,7 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateOptions& em) {
       ->check(CLI::IsMember({"builtin", "rs274"}))
       ->capture_default_str();
   add_dialect_option(emu, em.dialect);
+  add_start_tool_option(emu, em.start_tool);
   return emu;
 }
 

@@ -411,6 +411,7 @@ void ControlFlow::leave(const OWord& o) {
     value = expr_.bracketed(code, p);
     if (p != code.size()) fail("unexpected '" + code.substr(p) + "' after " + owtext(o));
   }
+  if (on_leave_) on_leave_(call_level());
   params_.pop_frame();
   stack_.pop_back();
   stack_.back().pc += 1;
@@ -501,6 +502,7 @@ bool ControlFlow::fanuc_return(const OWord& o) {
     a.pc = a.entry;
     return true;
   }
+  if (on_leave_) on_leave_(call_level());
   if (a.frame) params_.pop_frame();
   stack_.pop_back();
   if (target >= 0) jump_to_number(target, "M99 P" + std::to_string(target));

@@ -86,6 +86,10 @@ class ControlFlow {
 
   [[noreturn]] void fail(const std::string& msg) const;
 
+  // Called when a subroutine returns (endsub, return), with the call level being left
+  // (M73 restores the modal state saved at that level).
+  void on_leave(std::function<void(int level)> hook) { on_leave_ = std::move(hook); }
+
  private:
   struct Activation {
     const NgcFile* file = nullptr;
@@ -140,6 +144,7 @@ class ControlFlow {
   std::vector<std::string> search_dirs_;
   long executed_ = 0;
   ModalCall modal_;
+  std::function<void(int level)> on_leave_;
 };
 
 }  // namespace lbr::nc::detail

@@ -1,5 +1,6 @@
 #include "path_builder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -13,6 +14,15 @@ PlaneAxes plane_axes(Plane p) noexcept {
     case Plane::YZ: return {Y, Z, X};
   }
   return {X, Y, Z};
+}
+
+double spindle_rpm(double s, bool css, double max_rpm, double mm_per_unit, double radius_mm) noexcept {
+  if (!css) return s;
+  const double surface_mm_per_min = s * (mm_per_unit == 1.0 ? 1000.0 : 304.8);
+  const double r = std::abs(radius_mm);
+  double rpm = r > 1e-6 ? surface_mm_per_min / (2.0 * std::numbers::pi * r) : HUGE_VAL;
+  if (max_rpm > 0.0) rpm = std::min(rpm, max_rpm);
+  return rpm;
 }
 
 PathBuilder::PathBuilder(const std::string& source, const GcodeOptions& options) : opt_(options) {

@@ -24,6 +24,12 @@ struct PlaneAxes {
 // G64 P in effect before the program sets one [mm] (0.001 inch).
 inline constexpr double kPowerUpBlendTolMm = 0.0254;
 
+// Spindle speed [rpm] for feed per revolution and spindle-synchronised moves (G95, G33, G33.1,
+// G76): in G97 (css = false) the S word; in G96 the speed that gives the surface speed S
+// [m/min, ft/min when mm_per_unit is 25.4] at radius |radius_mm|, capped by max_rpm (0: none).
+// Returns +inf at the spindle axis without a cap.
+[[nodiscard]] double spindle_rpm(double s, bool css, double max_rpm, double mm_per_unit, double radius_mm) noexcept;
+
 // At most this many chords per arc; more is reported as an error (keeps runaway input bounded).
 inline constexpr long kMaxArcChords = 1000000;
 

@@ -25,6 +25,7 @@ namespace {
 
 using detail::PathBuilder;
 using detail::Plane;
+using detail::spindle_rpm;
 
 constexpr double kInch = 25.4;
 
@@ -126,150 +127,219 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
+// The state of one pass over rs274's canonical output: the program frame, units, feed and
+// spindle (for feed per revolution and synchronised motion), all converted by PathBuilder.
+class CanonReader {
+ public:
+  CanonReader(const std::string& name, const GcodeOptions& options)
+      : name_(name), opt_(options), b_(name, options), g5x_(options.work_offsets[0]), selected_(options.start_tool) {}
+
+  Toolpath read(const std::string& canon) {
+    std::istringstream in(canon);
+    std::string raw;
+    while (std::getline(in, raw)) {
+      const CanonLine c = split_canon(raw);
+      if (!c.ok) continue;
+      if (c.line >= 0) line_ = c.line;
+      // Everything not handled (comments, coolant, messages, program end, ...) moves nothing.
+      if (!frame(c) && !motion(c) && !feed_and_spindle(c)) tools(c);
+    }
+    return b_.take();
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& m) const { throw ParseError(name_, line_, "rs274: " + m); }
+  // The numbers of a command (at least k); magnitudes above `limit` are refused.
+  std::vector<double> args(const CanonLine& c, std::size_t k, double limit = 1e9) const {
+    const std::vector<double> v = numbers(c.args);
+    if (v.size() < k)
+      fail("canonical command " + c.cmd + " has " + std::to_string(v.size()) + " numbers, expected " + std::to_string(k));
+    for (double x : v)
+      if (!std::isfinite(x) || std::abs(x) > limit) fail("canonical command " + c.cmd + " has a number out of range");
+    return v;
+  }
+  AxisVector axes(const std::vector<double>& v, std::size_t first) const {
+    AxisVector p{};
+    for (int a = 0; a < kAxes; ++a) p[a] = v[first + a] * (a <= Z ? scale_ : 1.0);
+    return p;
+  }
+  // A motion that moves an axis the machine lacks is refused, as the built-in interpreter does.
+  const AxisVector& checked(const AxisVector& p) const {
+    static const char* const kNames[kAxes] = {"X", "Y", "Z", "A", "B", "C"};
+    const AxisVector& cur = b_.position();
+    for (int a = 0; a < kAxes; ++a)
+      if (!machine_has_axis(opt_, a) && std::abs(p[a] - cur[a]) > 1e-9)
+        fail(std::string("the program moves axis ") + kNames[a] + ", which the machine lacks (" + machine_axes(opt_) + ")");
+    return p;
+  }
+  // Offsets change the program frame, not the machine position.
+  template <typename F>
+  void reframe(F&& change) {
+    const AxisVector m = b_.to_machine(b_.position());
+    change();
+    AxisVector o{};
+    for (int a = 0; a < kAxes; ++a) o[a] = g5x_[a] + g92_[a];
+    b_.set_origin(o);
+    b_.set_position(b_.from_machine(m));
+  }
+
+  bool frame(const CanonLine& c) {
+    const std::string& cmd = c.cmd;
+    if (cmd == "USE_LENGTH_UNITS") {
+      scale_ = c.args.find("INCHES") != std::string::npos ? kInch : c.args.find("CM") != std::string::npos ? 10.0 : 1.0;
+    } else if (cmd == "SET_G5X_OFFSET") {
+      const auto v = args(c, 7);
+      reframe([&] { g5x_ = axes(v, 1); });
+    } else if (cmd == "SET_G92_OFFSET") {
+      const auto v = args(c, 6);
+      reframe([&] { g92_ = axes(v, 0); });
+    } else if (cmd == "SET_XY_ROTATION") {
+      if (std::abs(args(c, 1)[0]) > 1e-12) fail("XY rotation (G10 L2 R) is not supported");
+    } else if (cmd == "USE_TOOL_LENGTH_OFFSET") {
+      const auto v = args(c, 3);
+      if (std::abs(v[0]) > 1e-12 || std::abs(v[1]) > 1e-12) fail("tool offsets in X or Y are not supported");
+      const AxisVector m = b_.to_machine(b_.position());
+      b_.set_tool_length_offset(v[2] * scale_);
+      b_.set_position(b_.from_machine(m));
+    } else if (cmd == "SELECT_PLANE") {
+      if (c.args.find("XZ") != std::string::npos) plane_ = Plane::ZX;
+      else if (c.args.find("YZ") != std::string::npos) plane_ = Plane::YZ;
+      else if (c.args.find("XY") != std::string::npos) plane_ = Plane::XY;
+      else fail("plane " + c.args + " is not supported");
+    } else if (cmd == "SET_MOTION_CONTROL_MODE" || cmd == "SET_NAIVECAM_TOLERANCE") {
+      path_control(c);
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  // G61 / G61.1 / G64 P (CANON_CONTINUOUS, tolerance) and G64 Q, for the emulator's planner.
+  void path_control(const CanonLine& c) {
+    const auto v = numbers(c.args);
+    if (c.cmd == "SET_NAIVECAM_TOLERANCE") {
+      path_q_mm_ = args(c, 1)[0] * scale_;
+    } else if (c.args.find("CONTINUOUS") != std::string::npos) {
+      path_ = PathControl::Blend;
+      path_p_mm_ = v.empty() ? 0.0 : v[0] * scale_;
+    } else {
+      path_ = c.args.find("EXACT_PATH") != std::string::npos ? PathControl::ExactPath : PathControl::ExactStop;
+    }
+    b_.set_path_control(path_, path_p_mm_, path_q_mm_);
+  }
+
+  // Feed rate [mm/min] of a STRAIGHT_FEED or ARC_FEED starting here: synchronised (K x rpm),
+  // per revolution (F x rpm) or per minute.
+  double feed_now(const std::string& cmd) const {
+    if (sync_k_ > 0.0 || per_rev_) {
+      const double rpm = spindle_rpm(spindle_s_, css_, css_max_rpm_, scale_, b_.position()[X]);
+      if (!(rpm > 0.0) || rpm > 1e9) fail(cmd + " per revolution or synchronised with the spindle needs a spindle speed S > 0 (at X0 in G96: D)");
+      return (sync_k_ > 0.0 ? sync_k_ : feed_ * scale_) * rpm;
+    }
+    if (feed_ <= 0.0) fail(cmd + " with zero feed rate");
+    return feed_ * scale_;
+  }
+
+  bool motion(const CanonLine& c) {
+    const std::string& cmd = c.cmd;
+    if (cmd == "STRAIGHT_TRAVERSE") {
+      b_.rapid(line_, checked(axes(args(c, 6), 0)));
+    } else if (cmd == "STRAIGHT_FEED") {
+      const AxisVector end = checked(axes(args(c, 6), 0));
+      b_.feed(line_, end, feed_now(cmd), false);  // SET_FEED_RATE is in units/min even for G93
+    } else if (cmd == "RIGID_TAP") {  // G33.1: to the end point and back, synchronised
+      const auto v = args(c, 3);
+      const AxisVector start = b_.position();
+      AxisVector end = start;
+      for (int a = X; a <= Z; ++a) end[a] = v[static_cast<std::size_t>(a)] * scale_;
+      b_.feed(line_, checked(end), feed_now(cmd), false);
+      b_.feed(line_, start, feed_now(cmd), false);
+    } else if (cmd == "ARC_FEED") {
+      arc_feed(c);
+    } else if (cmd == "DWELL") {
+      const auto v = args(c, 1);
+      if (v[0] < 0.0) fail("DWELL with a negative time");
+      b_.dwell(line_, v[0]);
+    } else if (cmd.find("PROBE") != std::string::npos || cmd.find("NURBS") != std::string::npos ||
+               cmd.find("SPLINE") != std::string::npos || cmd.ends_with("_FEED") || cmd.ends_with("_TRAVERSE")) {
+      fail("canonical command " + cmd + " is not supported");
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  void arc_feed(const CanonLine& c) {
+    const auto v = args(c, 9);
+    const detail::PlaneAxes ax = detail::plane_axes(plane_);
+    AxisVector end = b_.position();
+    end[ax.u] = v[0] * scale_;
+    end[ax.v] = v[1] * scale_;
+    end[ax.w] = v[5] * scale_;
+    end[A] = v[6], end[B] = v[7], end[C] = v[8];
+    (void)checked(end);
+    if (std::abs(v[4]) > 1000.0) fail("ARC_FEED with more than 1000 turns");
+    const int rot = static_cast<int>(std::lround(v[4]));
+    if (rot == 0) fail("ARC_FEED with rotation 0");
+    b_.arc(line_, plane_, end, v[2] * scale_, v[3] * scale_, rot, feed_now("ARC_FEED"), false);
+  }
+
+  bool feed_and_spindle(const CanonLine& c) {
+    const std::string& cmd = c.cmd;
+    if (cmd == "SET_FEED_RATE") {
+      feed_ = args(c, 1)[0];
+    } else if (cmd == "SET_FEED_MODE") {
+      // rs274 turns inverse time (G93) into units/min rates itself; mode 1 is per revolution.
+      per_rev_ = std::lround(args(c, 1).back()) == 1;
+    } else if (cmd == "SET_SPINDLE_SPEED") {
+      spindle_s_ = args(c, 2)[1];
+    } else if (cmd == "SET_SPINDLE_MODE") {  // (spindle max): max > 0 is G96 with that cap (1e30: none)
+      const double max = args(c, 2, 1e31)[1];
+      css_ = max > 0.0;
+      css_max_rpm_ = max >= 1e29 ? 0.0 : max;
+    } else if (cmd == "START_SPEED_FEED_SYNC") {  // G33, G33.1, G76: (K [units/rev], velocity mode)
+      sync_k_ = args(c, 1)[0] * scale_;
+      if (!(sync_k_ > 0.0)) fail("START_SPEED_FEED_SYNC with K <= 0");
+    } else if (cmd == "STOP_SPEED_FEED_SYNCH") {
+      sync_k_ = 0.0;
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  void tools(const CanonLine& c) {
+    const std::string& cmd = c.cmd;
+    if (cmd == "SELECT_TOOL") {
+      selected_ = static_cast<int>(std::lround(args(c, 1)[0]));
+    } else if (cmd == "CHANGE_TOOL") {
+      b_.tool_change(line_, selected_);
+    } else if (cmd == "CHANGE_TOOL_NUMBER") {  // M61 Q: this tool is in the spindle now
+      selected_ = static_cast<int>(std::lround(args(c, 1)[0]));
+      b_.tool_change(line_, selected_);
+    }
+  }
+
+  const std::string& name_;
+  const GcodeOptions& opt_;
+  PathBuilder b_;
+  double scale_ = 1.0;
+  AxisVector g5x_, g92_{};
+  Plane plane_ = Plane::XY;
+  double feed_ = 0.0;
+  bool per_rev_ = false;
+  double spindle_s_ = 0.0, css_max_rpm_ = 0.0, sync_k_ = 0.0;  // S [rpm or surface speed], G96 cap, K [mm/rev]
+  bool css_ = false;
+  int selected_ = 0;
+  PathControl path_ = PathControl::Blend;
+  double path_p_mm_ = 0.0, path_q_mm_ = 0.0;
+  int line_ = 0;
+};
+
 }  // namespace
 
 Toolpath parse_rs274_canon(const std::string& canon, const std::string& name, const GcodeOptions& options) {
-  PathBuilder b(name, options);
-  double scale = 1.0;
-  AxisVector g5x = options.work_offsets[0], g92{};
-  Plane plane = Plane::XY;
-  double feed = 0.0;
-  const bool inverse = false;  // SET_FEED_RATE is always in length units per minute
-  int selected = options.start_tool;
-  PathControl path = PathControl::Blend;
-  double path_p_mm = 0.0, path_q_mm = 0.0;
-  int line = 0;
-  std::istringstream in(canon);
-  std::string raw;
-  auto fail = [&](const std::string& m) { throw ParseError(name, line, "rs274: " + m); };
-  auto need = [&](const std::vector<double>& v, std::size_t k, const std::string& cmd) {
-    if (v.size() < k) fail("canonical command " + cmd + " has " + std::to_string(v.size()) + " numbers, expected " + std::to_string(k));
-    for (double x : v)
-      if (!std::isfinite(x) || std::abs(x) > 1e9) fail("canonical command " + cmd + " has a number out of range");
-  };
-  // Offsets change the program frame, not the machine position.
-  auto reframe = [&](auto&& change) {
-    const AxisVector m = b.to_machine(b.position());
-    change();
-    AxisVector o{};
-    for (int a = 0; a < kAxes; ++a) o[a] = g5x[a] + g92[a];
-    b.set_origin(o);
-    b.set_position(b.from_machine(m));
-  };
-  auto axes = [&](const std::vector<double>& v, std::size_t first) {
-    AxisVector p{};
-    for (int a = 0; a < kAxes; ++a) p[a] = v[first + a] * (a <= Z ? scale : 1.0);
-    return p;
-  };
-  // A motion that moves an axis the machine lacks is refused, as the built-in interpreter does.
-  auto check_axes = [&](const AxisVector& p) {
-    static const char* const kNames[kAxes] = {"X", "Y", "Z", "A", "B", "C"};
-    const AxisVector& cur = b.position();
-    for (int a = 0; a < kAxes; ++a)
-      if (!machine_has_axis(options, a) && std::abs(p[a] - cur[a]) > 1e-9)
-        fail(std::string("the program moves axis ") + kNames[a] + ", which the machine lacks (" +
-             machine_axes(options) + ")");
-    return p;
-  };
-  while (std::getline(in, raw)) {
-    const CanonLine c = split_canon(raw);
-    if (!c.ok) continue;
-    if (c.line >= 0) line = c.line;
-    const std::string& cmd = c.cmd;
-    if (cmd == "USE_LENGTH_UNITS") {
-      if (c.args.find("INCHES") != std::string::npos) scale = kInch;
-      else if (c.args.find("CM") != std::string::npos) scale = 10.0;
-      else scale = 1.0;
-    } else if (cmd == "SET_G5X_OFFSET") {
-      const auto v = numbers(c.args);
-      need(v, 7, cmd);
-      reframe([&] { g5x = axes(v, 1); });
-    } else if (cmd == "SET_G92_OFFSET") {
-      const auto v = numbers(c.args);
-      need(v, 6, cmd);
-      reframe([&] { g92 = axes(v, 0); });
-    } else if (cmd == "SET_XY_ROTATION") {
-      const auto v = numbers(c.args);
-      need(v, 1, cmd);
-      if (std::abs(v[0]) > 1e-12) fail("XY rotation (G10 L2 R) is not supported");
-    } else if (cmd == "USE_TOOL_LENGTH_OFFSET") {
-      const auto v = numbers(c.args);
-      need(v, 3, cmd);
-      if (std::abs(v[0]) > 1e-12 || std::abs(v[1]) > 1e-12) fail("tool offsets in X or Y are not supported");
-      const AxisVector m = b.to_machine(b.position());
-      b.set_tool_length_offset(v[2] * scale);
-      b.set_position(b.from_machine(m));
-    } else if (cmd == "STRAIGHT_TRAVERSE") {
-      const auto v = numbers(c.args);
-      need(v, 6, cmd);
-      b.rapid(line, check_axes(axes(v, 0)));
-    } else if (cmd == "STRAIGHT_FEED") {
-      const auto v = numbers(c.args);
-      need(v, 6, cmd);
-      if (feed <= 0.0) fail("STRAIGHT_FEED with zero feed rate");
-      b.feed(line, check_axes(axes(v, 0)), inverse ? feed : feed * scale, inverse);
-    } else if (cmd == "ARC_FEED") {
-      const auto v = numbers(c.args);
-      need(v, 9, cmd);
-      const detail::PlaneAxes ax = detail::plane_axes(plane);
-      AxisVector end = b.position();
-      end[ax.u] = v[0] * scale;
-      end[ax.v] = v[1] * scale;
-      end[ax.w] = v[5] * scale;
-      end[A] = v[6], end[B] = v[7], end[C] = v[8];
-      (void)check_axes(end);
-      if (std::abs(v[4]) > 1000.0) fail("ARC_FEED with more than 1000 turns");
-      const int rot = static_cast<int>(std::lround(v[4]));
-      if (rot == 0) fail("ARC_FEED with rotation 0");
-      if (feed <= 0.0) fail("ARC_FEED with zero feed rate");
-      b.arc(line, plane, end, v[2] * scale, v[3] * scale, rot, inverse ? feed : feed * scale, inverse);
-    } else if (cmd == "SET_FEED_RATE") {
-      const auto v = numbers(c.args);
-      need(v, 1, cmd);
-      feed = v[0];
-    } else if (cmd == "SET_FEED_MODE") {
-      const auto v = numbers(c.args);
-      need(v, 1, cmd);
-      // rs274 turns inverse time (G93) into units/min rates itself; mode 1 is feed per revolution.
-      if (std::lround(v.back()) != 0) fail("feed per revolution (G95) is not supported");
-    } else if (cmd == "DWELL") {
-      const auto v = numbers(c.args);
-      need(v, 1, cmd);
-      if (v[0] < 0.0) fail("DWELL with a negative time");
-      b.dwell(line, v[0]);
-    } else if (cmd == "SELECT_TOOL") {
-      const auto v = numbers(c.args);
-      need(v, 1, cmd);
-      selected = static_cast<int>(std::lround(v[0]));
-    } else if (cmd == "CHANGE_TOOL") {
-      b.tool_change(line, selected);
-    } else if (cmd == "CHANGE_TOOL_NUMBER") {  // M61 Q: this tool is in the spindle now
-      const auto v = numbers(c.args);
-      need(v, 1, cmd);
-      selected = static_cast<int>(std::lround(v[0]));
-      b.tool_change(line, selected);
-    } else if (cmd == "SET_MOTION_CONTROL_MODE" || cmd == "SET_NAIVECAM_TOLERANCE") {
-      // G61 / G61.1 / G64 P (CANON_CONTINUOUS, tolerance) and G64 Q, for the emulator's planner.
-      const auto v = numbers(c.args);
-      if (cmd == "SET_NAIVECAM_TOLERANCE") need(v, 1, cmd), path_q_mm = v[0] * scale;
-      else if (c.args.find("CONTINUOUS") != std::string::npos) path = PathControl::Blend, path_p_mm = v.empty() ? 0.0 : v[0] * scale;
-      else path = c.args.find("EXACT_PATH") != std::string::npos ? PathControl::ExactPath : PathControl::ExactStop;
-      b.set_path_control(path, path_p_mm, path_q_mm);
-    } else if (cmd == "SELECT_PLANE") {
-      if (c.args.find("XZ") != std::string::npos) plane = Plane::ZX;
-      else if (c.args.find("YZ") != std::string::npos) plane = Plane::YZ;
-      else if (c.args.find("XY") != std::string::npos) plane = Plane::XY;
-      else fail("plane " + c.args + " is not supported");
-    } else if (cmd.starts_with("START_SPEED_FEED_SYNC")) {
-      fail("spindle-synchronised motion (G33, G33.1, G76) is not supported: the tool path carries no spindle angle");
-    } else if (cmd.find("PROBE") != std::string::npos || cmd == "RIGID_TAP" || cmd.find("NURBS") != std::string::npos ||
-               cmd.find("SPLINE") != std::string::npos ||
-               cmd.ends_with("_FEED") || cmd.ends_with("_TRAVERSE")) {
-      fail("canonical command " + cmd + " is not supported");
-    }
-    // Everything else (comments, spindle, coolant, messages, program end, ...) moves nothing.
-  }
-  return b.take();
+  return CanonReader(name, options).read(canon);
 }
 
 std::string find_rs274() {
@@ -285,62 +355,35 @@ std::string find_rs274() {
   return "";
 }
 
-Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options) {
-  const std::string exe = find_rs274();
-  if (exe.empty())
-    throw std::runtime_error(
-        "--interpreter rs274: the rs274 program (LinuxCNC's G-code interpreter, Debian package linuxcnc-uspace) "
-        "is not on PATH; install it, or leave out --interpreter to use the built-in interpreter");
-  const std::string text = read_text_file(program_path);
+namespace {
 
-  // Number every program line (N<line>) so that rs274's canonical lines name source lines.
+// The program with every line numbered N<line> so that rs274's canonical lines name source
+// lines; lathes start with the profile's G7/G8 (standalone rs274 ignores the INI's
+// RS274NGC_STARTUP_CODE), after a leading '%'.
+std::string numbered_program(const std::string& text, const GcodeOptions& options) {
   std::ostringstream numbered;
-  {
-    std::istringstream in(text);
-    std::string l;
-    int k = 0;
-    while (std::getline(in, l)) {
-      ++k;
-      if (!l.empty() && l.back() == '\r') l.pop_back();
-      std::size_t i = l.find_first_not_of(" \t");
-      if (i == std::string::npos || l[i] == '%') {
-        numbered << l << '\n';
-        continue;
-      }
-      std::string prefix;
-      if (l[i] == '/') prefix = "/", ++i;
-      std::size_t j = i;
-      if (j < l.size() && (l[j] == 'N' || l[j] == 'n')) {  // drop an existing line number
-        std::size_t e = j + 1;
-        while (e < l.size() && std::isdigit(static_cast<unsigned char>(l[e]))) ++e;
-        if (e > j + 1) i = e;
-      }
-      const std::string n_word = "N" + std::to_string(k);
-      numbered << prefix << n_word << ' ' << split_m6_g43(l.substr(i), n_word) << '\n';
+  std::istringstream in(text);
+  std::string l;
+  int k = 0;
+  while (std::getline(in, l)) {
+    ++k;
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    std::size_t i = l.find_first_not_of(" \t");
+    if (i == std::string::npos || l[i] == '%') {
+      numbered << l << '\n';
+      continue;
     }
+    std::string prefix;
+    if (l[i] == '/') prefix = "/", ++i;
+    std::size_t j = i;
+    if (j < l.size() && (l[j] == 'N' || l[j] == 'n')) {  // drop an existing line number
+      std::size_t e = j + 1;
+      while (e < l.size() && std::isdigit(static_cast<unsigned char>(l[e]))) ++e;
+      if (e > j + 1) i = e;
+    }
+    const std::string n_word = "N" + std::to_string(k);
+    numbered << prefix << n_word << ' ' << split_m6_g43(l.substr(i), n_word) << '\n';
   }
-
-  std::string tmpl = (std::filesystem::temp_directory_path() / "lbrsim-rs274-XXXXXX").string();
-  std::vector<char> buf(tmpl.begin(), tmpl.end());
-  buf.push_back('\0');
-  if (::mkdtemp(buf.data()) == nullptr) throw std::runtime_error("rs274: cannot create a temporary directory");
-  const std::filesystem::path dir(buf.data());
-  struct Cleanup {
-    std::filesystem::path d;
-    ~Cleanup() {
-      std::error_code ec;
-      std::filesystem::remove_all(d, ec);
-    }
-  } cleanup{dir};
-
-  auto write = [&](const char* name, const std::string& content) {
-    std::ofstream f(dir / name, std::ios::binary);
-    f << content;
-    if (!f) throw std::runtime_error("rs274: cannot write " + (dir / name).string());
-  };
-  // Lathes start in the profile's diameter/radius mode: standalone rs274 ignores the INI's
-  // RS274NGC_STARTUP_CODE, so a G7/G8 block without a line number goes first (after a
-  // leading '%').
   std::string prog = numbered.str();
   if (options.machine == MachineKind::Lathe || options.machine == MachineKind::LatheC) {
     const std::string mode = options.diameter_mode ? "G7\n" : "G8\n";
@@ -348,15 +391,11 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
     if (first != std::string::npos && prog[first] == '%') prog.insert(prog.find('\n', first) + 1, mode);
     else prog.insert(0, mode);
   }
-  write("program.ngc", prog);
-  // Subroutines: the program's directory, then [nc] subroutine_path (as the built-in interpreter).
-  // (A bare file name has an empty parent: the working directory.)
-  const std::filesystem::path program_dir = std::filesystem::path(program_path).parent_path();
-  std::string sub_path = std::filesystem::absolute(program_dir.empty() ? std::filesystem::path(".") : program_dir).string();
-  for (const std::string& d : options.subroutine_path) sub_path += ":" + std::filesystem::absolute(d).string();
-  std::string ini = "[RS274NGC]\nPARAMETER_FILE=rs274.var\nSUBROUTINE_PATH=" + sub_path + "\n";
-  write("rs274.ini", ini);
-  // Standalone rs274 works in inches internally: tool table and parameters are in inches.
+  return prog;
+}
+
+// Standalone rs274 works in inches internally: tool table and parameters are in inches.
+std::string tool_table(const GcodeOptions& options) {
   std::ostringstream tbl;
   tbl.precision(12);
   int pocket = 1;
@@ -367,7 +406,10 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
     if (t <= 0) continue;
     tbl << 'T' << t << " P" << pocket++ << std::fixed << " Z" << ld.first / kInch << " D" << ld.second / kInch << " ;\n";
   }
-  write("tool.tbl", tbl.str());
+  return tbl.str();
+}
+
+std::string parameter_file(const GcodeOptions& options) {
   std::ostringstream var;
   var.precision(12);
   var << std::fixed;
@@ -378,50 +420,103 @@ Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options)
   put_axes(5181, options.g30_home);
   var << 5220 << '\t' << 1.0 << '\n';
   for (int k = 0; k < 9; ++k) put_axes(5221 + 20 * k, options.work_offsets[static_cast<std::size_t>(k)]);
-  write("rs274.var", var.str());
+  return var.str();
+}
 
-  // LinuxCNC's rs274 shares state between concurrent processes (seen here: "Bus error" when
-  // two run at once), so runs are serialised machine-wide with flock(1) on one lock file.
-  const std::string lock = (std::filesystem::temp_directory_path() / "lbrsim-rs274.lock").string();
-  const std::string cmd = "cd " + shell_quote(dir.string()) + " && flock " + shell_quote(lock) + " timeout 120 " +
-                          shell_quote(exe) + " -g -i rs274.ini -t tool.tbl -v rs274.var program.ngc < /dev/null 2>&1";
+// Subroutines: the program's directory, then [nc] subroutine_path (as the built-in interpreter).
+// (A bare file name has an empty parent: the working directory.)
+std::string ini_file(const std::string& program_path, const GcodeOptions& options) {
+  const std::filesystem::path program_dir = std::filesystem::path(program_path).parent_path();
+  std::string sub_path = std::filesystem::absolute(program_dir.empty() ? std::filesystem::path(".") : program_dir).string();
+  for (const std::string& d : options.subroutine_path) sub_path += ":" + std::filesystem::absolute(d).string();
+  return "[RS274NGC]\nPARAMETER_FILE=rs274.var\nSUBROUTINE_PATH=" + sub_path + "\n";
+}
+
+// A temporary directory, removed with everything in it at the end of the scope.
+struct TempDir {
+  std::filesystem::path d;
+  TempDir() {
+    std::string tmpl = (std::filesystem::temp_directory_path() / "lbrsim-rs274-XXXXXX").string();
+    std::vector<char> buf(tmpl.begin(), tmpl.end());
+    buf.push_back('\0');
+    if (::mkdtemp(buf.data()) == nullptr) throw std::runtime_error("rs274: cannot create a temporary directory");
+    d = buf.data();
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(d, ec);
+  }
+  void write(const char* name, const std::string& content) const {
+    std::ofstream f(d / name, std::ios::binary);
+    f << content;
+    if (!f) throw std::runtime_error("rs274: cannot write " + (d / name).string());
+  }
+};
+
+// Runs a shell command; returns its exit status and stdout.
+int run_command(const std::string& cmd, const std::string& exe, std::string& out) {
   FILE* p = ::popen(cmd.c_str(), "r");
   if (p == nullptr) throw std::runtime_error("rs274: cannot start " + exe);
-  std::string out;
   char chunk[4096];
   std::size_t got = 0;
   while ((got = std::fread(chunk, 1, sizeof chunk, p)) > 0) out.append(chunk, got);
   const int status = ::pclose(p);
-  const int rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (rc != 0) {
-    // rs274 prints the error, then the offending block (with our N<line>).
-    // (print, ...) output comes before; the message is the line before the echoed block.
-    // A block in a subroutine file carries no N<line>: the last canonical line's N is used.
-    std::istringstream in(out);
-    std::string l, msg;
-    std::vector<std::string> shown;
-    int line = 0, last_canon = 0;
-    while (std::getline(in, l)) {
-      if (const CanonLine c = split_canon(l); c.ok) {
-        if (c.line > 0) last_canon = c.line;
-        continue;
-      }
-      if (l.starts_with("executing")) continue;
-      if (l.size() > 1 && l[0] == 'N' && std::isdigit(static_cast<unsigned char>(l[1])) && !shown.empty()) {
-        line = static_cast<int>(std::min(std::strtol(l.c_str() + 1, nullptr, 10), 1000000000L));
-        break;
-      }
-      shown.push_back(l);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// rs274 prints the error, then the offending block (with our N<line>). (print, ...) output
+// comes before; the message is the line before the echoed block. A block in a subroutine file
+// carries no N<line>: the last canonical line's N is used.
+ParseError rs274_error(const std::string& out, int rc, const std::string& program_path) {
+  std::istringstream in(out);
+  std::string l, msg;
+  std::vector<std::string> shown;
+  int line = 0, last_canon = 0;
+  while (std::getline(in, l)) {
+    if (const CanonLine c = split_canon(l); c.ok) {
+      if (c.line > 0) last_canon = c.line;
+      continue;
     }
-    for (auto it = shown.rbegin(); it != shown.rend() && msg.empty(); ++it)
-      if (it->find_first_not_of(" \t") != std::string::npos) msg = *it;
-    if (line == 0) line = last_canon;
-    for (std::size_t at = msg.find("program.ngc"); at != std::string::npos; at = msg.find("program.ngc", at + 1))
-      msg.replace(at, std::string("program.ngc").size(), program_path);
-    if (rc == 124) msg = "did not finish within 120 s";
-    if (msg.empty()) msg = "failed with exit status " + std::to_string(rc);
-    throw ParseError(program_path, line, "rs274: " + msg);
+    if (l.starts_with("executing")) continue;
+    if (l.size() > 1 && l[0] == 'N' && std::isdigit(static_cast<unsigned char>(l[1])) && !shown.empty()) {
+      line = static_cast<int>(std::min(std::strtol(l.c_str() + 1, nullptr, 10), 1000000000L));
+      break;
+    }
+    shown.push_back(l);
   }
+  for (auto it = shown.rbegin(); it != shown.rend() && msg.empty(); ++it)
+    if (it->find_first_not_of(" \t") != std::string::npos) msg = *it;
+  if (line == 0) line = last_canon;
+  for (std::size_t at = msg.find("program.ngc"); at != std::string::npos; at = msg.find("program.ngc", at + 1))
+    msg.replace(at, std::string("program.ngc").size(), program_path);
+  if (rc == 124) msg = "did not finish within 120 s";
+  if (msg.empty()) msg = "failed with exit status " + std::to_string(rc);
+  return ParseError(program_path, line, "rs274: " + msg);
+}
+
+}  // namespace
+
+Toolpath run_rs274(const std::string& program_path, const GcodeOptions& options) {
+  const std::string exe = find_rs274();
+  if (exe.empty())
+    throw std::runtime_error(
+        "--interpreter rs274: the rs274 program (LinuxCNC's G-code interpreter, Debian package linuxcnc-uspace) "
+        "is not on PATH; install it, or leave out --interpreter to use the built-in interpreter");
+  const TempDir dir;
+  dir.write("program.ngc", numbered_program(read_text_file(program_path), options));
+  dir.write("rs274.ini", ini_file(program_path, options));
+  dir.write("tool.tbl", tool_table(options));
+  dir.write("rs274.var", parameter_file(options));
+  // LinuxCNC's rs274 shares state between concurrent processes (seen here: "Bus error" when
+  // two run at once), so runs are serialised machine-wide with flock(1) on one lock file.
+  const std::string lock = (std::filesystem::temp_directory_path() / "lbrsim-rs274.lock").string();
+  const std::string cmd = "cd " + shell_quote(dir.d.string()) + " && flock " + shell_quote(lock) + " timeout 120 " +
+                          shell_quote(exe) + " -g -i rs274.ini -t tool.tbl -v rs274.var program.ngc < /dev/null 2>&1";
+  std::string out;
+  const int rc = run_command(cmd, exe, out);
+  if (rc != 0) throw rs274_error(out, rc, program_path);
   return parse_rs274_canon(out, program_path, options);
 }
 

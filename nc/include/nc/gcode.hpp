@@ -2,8 +2,8 @@
 //
 // Two front ends produce the same Toolpath from a part program:
 //  - interpret_gcode(): the built-in interpreter (coverage in docs/nc-frontend.md);
-//  - the LinuxCNC `rs274` canonical-command stream (nc/rs274.hpp), for programs that use
-//    subroutines, parameters, loops or cutter compensation.
+//  - the LinuxCNC `rs274` canonical-command stream (nc/rs274.hpp), for what the built-in
+//    interpreter refuses (G70-G72 lathe cycles, G84-G89, probing, remaps) and as its reference.
 //
 // Frames (docs/nc-frontend.md#frames): the Toolpath is in the G54 frame as it stands at
 // program start (GcodeOptions::work_offsets[0]); the profile's stock is given in that frame.
@@ -37,8 +37,8 @@ struct GcodeOptions {
   MachineKind machine = MachineKind::Mill3;
   Dialect dialect = Dialect::Rs274ngc;
   std::map<int, double> tool_lengths;    // tool number -> gauge line to tip [mm]; missing = 0
-  std::map<int, double> tool_diameters;  // tool number -> diameter [mm]; used by rs274's cutter
-                                         // compensation (the built-in interpreter rejects G41/G42)
+  std::map<int, double> tool_diameters;  // tool number -> diameter [mm]; cutter radius
+                                         // compensation (G41/G42 D) in both front ends
   double chord_tol_mm = 0.001;         // max distance of an arc chord from the arc [mm]
   // Machine coordinates of the G54, G55, ... G59, G59.1, G59.2, G59.3 origins [mm, deg]
   // at program start (G10 L2 changes them while the program runs). work_offsets[0] defines
