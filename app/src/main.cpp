@@ -562,6 +562,9 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_option("--out", ro.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
   run->add_option("--record", ro.live.record, "Record the raw input to this file (candump -l format)");
   run->add_flag("--quiet", ro.quiet, "No status lines");
+  run->add_option("--status-every", ro.live.status_period_s, "Seconds between status lines (each gives the lag p99 since the last)")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
   run->add_flag("--no-window", ro.no_window, "Do not open the viewer even when a display exists");
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
   run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "

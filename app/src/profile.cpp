@@ -223,6 +223,7 @@ void read_live(Section& top, Profile& p, const std::string& name) {
     if (const toml::table* st = s.table("serial")) {
       Section ss(*st, "live.serial", name);
       L.serial.baud = static_cast<int>(ss.integer("baud", 115200, 1200, 4000000));
+      L.serial.reconnect_ms = ss.number("reconnect_ms", 0.0, 0.0, 60000.0, "ms");
       ss.reject_unknown();
     }
     if (const toml::table* ct = s.table("can")) {
