@@ -299,3 +299,44 @@ TEST(SerialSource, HangUpEndsTheSourceWithoutReconnect) {
   EXPECT_EQ(sink.seqs.size(), 3U);
   EXPECT_EQ(src->counters().get(Fault::Reconnect), 0U);
 }
+
+// Regression (UBSan in fuzz_serial, docs/reliability.md): a frame's 64-bit t_us × 1000
+// overflowed int64. Wire timestamps beyond kMaxSerialTimeUs are invalid values now.
+TEST(SerialMapping, RegressionTimestampBeyondInt64Nanoseconds) {
+  LiveConfig cfg;
+  cfg.axes = default_axes();
+  std::array<AxisSample, kMaxChannels> out{};
+  Counters c;
+  SerialFrame f;
+  f.seq = 1;
+  f.n = 3;
+  f.pos = {1, 2, 3};
+  f.t_us = kMaxSerialTimeUs + 1;
+  EXPECT_EQ(frame_to_samples(f, cfg, 0, out, c), 0);
+  EXPECT_EQ(c.get(Fault::InvalidValue), 1u);
+  f.t_us = ~std::uint64_t{0};
+  EXPECT_EQ(frame_to_samples(f, cfg, 0, out, c), 0);
+  f.t_us = kMaxSerialTimeUs;
+  ASSERT_EQ(frame_to_samples(f, cfg, 0, out, c), 1);
+  EXPECT_EQ(out[0].t_src_ns, static_cast<std::int64_t>(kMaxSerialTimeUs) * 1000);
+}
+
+// The 32-bit serial sequence wraps: the jump check takes the step modulo 2^32 (before, the
+// wrap looked like 2^64 − 2^32 periods and let any jump through).
+TEST(Validator, SequenceWrapIsOnePeriod) {
+  LiveConfig cfg;
+  cfg.axes = default_axes();
+  for (auto& m : cfg.axes) m.max_speed_per_s = 100.0;
+  Validator v(cfg);
+  Counters c;
+  AxisSample s;
+  s.mask = 0b111;
+  s.seq = 0xFFFFFFFFu;
+  EXPECT_TRUE(v.accept(s, c));
+  s.seq = 0;
+  s.q[0] = 50.0;  // 50 mm in one period
+  EXPECT_FALSE(v.accept(s, c));
+  EXPECT_EQ(c.get(Fault::Jump), 1u);
+  s.q[0] = 0.1;
+  EXPECT_TRUE(v.accept(s, c));
+}

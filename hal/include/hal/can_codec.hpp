@@ -25,10 +25,15 @@ struct CanFrame {
   std::int64_t t_ns = 0;  // receive time (kernel timestamp or log time) [ns]
 };
 
-// Parses one candump -l line "(SEC.USEC) IFACE ID#HEXDATA" (also ID#R for RTR, 8-digit ids
-// are extended, error frames carry the 0x20000000 flag). Pure; false on malformed lines.
+// Parses one candump -l line "(SEC.USEC) IFACE ID#HEXDATA" (also ID#R or ID#R<DLC> for RTR,
+// 8-digit ids are extended, error frames carry the 0x20000000 flag). IFACE: 1..15 printable
+// characters; SEC at most kMaxCandumpSec (so the time fits in int64 ns). Pure; false on
+// malformed lines.
+inline constexpr std::int64_t kMaxCandumpSec = 9'000'000'000;  // year 2255
 [[nodiscard]] bool parse_candump_line(std::string_view line, CanFrame& f, std::string_view* iface = nullptr) noexcept;
-// Formats a frame the way candump -l does; returns the length written (0 if `out` is too small).
+// Formats a frame the way candump -l does ("(%010lu.%06lu) IFACE ID#DATA"); returns the
+// length written, 0 if `out` is too small, the interface name is not one parse_candump_line
+// accepts, t_ns is negative or len > 8.
 std::size_t format_candump_line(const CanFrame& f, std::string_view iface, std::span<char> out) noexcept;
 
 class CanopenAssembler {
