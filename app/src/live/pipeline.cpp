@@ -65,7 +65,7 @@ void write_record_line(std::FILE* f, const hal::RawRecord& r, const std::string&
   char line[256];
   if (r.serial) {
     const long long sec = r.t_wall_ns / 1'000'000'000, usec = (r.t_wall_ns % 1'000'000'000) / 1000;
-    int n = std::snprintf(line, sizeof line, "(%lld.%06lld) serial #", sec, usec);
+    int n = std::snprintf(line, sizeof line, "(%010lld.%06lld) serial #", sec, usec);
     for (std::uint16_t i = 0; i < r.len && n + 3 < static_cast<int>(sizeof line); ++i)
       n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), "%02X", r.bytes[i]);
     std::fputs(line, f);
