@@ -16,7 +16,7 @@ SECONDS_MAX="${4:-600}"
 shift $(( $# < 4 ? $# : 4 ))
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=(serial candump canopen movelist gcode rs274_canon profile lbrs)
-declare -A MAXLEN=([serial]=512 [candump]=128 [canopen]=1024 [gcode]=512 [rs274_canon]=512 [movelist]=512 [profile]=2048 [lbrs]=2048)
+declare -A MAXLEN=([serial]=512 [candump]=128 [canopen]=1024 [gcode]=512 [rs274_canon]=512 [movelist]=512 [profile]=2048 [lbrs]=8192)
 mkdir -p "$OUT"
 printf "%-12s %12s %9s %7s %8s %7s %7s %s\n" target execs execs/s cov ft corpus crashes seconds
 for t in "${TARGETS[@]}"; do

@@ -119,8 +119,12 @@ expect(missed >= 0, f"lbrsim recorded {-missed} frames more than candump")
 cd_err = rep_cd["decode_errors"]
 expect(feed["corrupted"] - 3 <= cd_err["length"] <= feed["corrupted"], f"candump replay length {cd_err['length']}")
 expect(0 <= feed["syncs"] - (rep_cd["samples_received"] + rep_cd["samples_lost"]) <= 1, "candump replay: syncs = samples + lost")
+# Volume: candump keeps listening while lbrsim reconnects after the interface comes back,
+# so its file can hold cycles lbrsim never saw; only when it holds no more (all but a
+# cycle's frames) must the volumes agree.
 c = rep_cd["removed_volume_mm3"]
-expect(abs(c - a) <= 1e-3 * abs(a), f"volume candump replay {c} live {a}")
+if missed <= 4:
+    expect(abs(c - a) <= 5e-5 * abs(a), f"volume candump replay {c} live {a}")
 # canplayer → lbrsim: the recorded samples again. canplayer sends what is due every 1 ms
 # (-g), so the play run's profile allows TPDOs 50 ms after their SYNC (init.sh).
 p = play["removed_volume_mm3"]

@@ -49,11 +49,15 @@ class CanopenAssembler {
 
   [[nodiscard]] std::uint64_t syncs() const noexcept { return syncs_; }
   [[nodiscard]] std::uint64_t samples() const noexcept { return samples_; }
-  // Cycles that never completed plus cycles skipped by the SYNC counter.
+  // Cycles that never completed plus cycles skipped by the SYNC counter. The counter repeats
+  // every sync_counter_max SYNCs; a silence of more than that (outage, bus-off, reconnect)
+  // hides whole turns of it, which the SYNC times reveal: whole turns are added when the
+  // time since the last SYNC exceeds the counter's gap by at least 0.9 of a turn.
   [[nodiscard]] std::uint64_t lost() const noexcept { return lost_; }
 
  private:
   void close_cycle(Counters& c) noexcept;
+  [[nodiscard]] std::uint64_t hidden_turns(std::int64_t t_ns, std::uint64_t gap) const noexcept;
 
   LiveConfig cfg_;
   std::array<std::int16_t, 128> node_map_{};  // node → index in cfg_.axes, -1 unmapped
@@ -68,6 +72,8 @@ class CanopenAssembler {
   int answered_count_ = 0;
   bool completed_ = false;
   int last_counter_ = -1;
+  std::int64_t last_sync_t_ = 0;
+  double period_ns_ = 1e6;
   std::uint64_t syncs_ = 0, samples_ = 0, lost_ = 0;
 };
 
