@@ -193,3 +193,64 @@ TEST(Candump, ParseAndFormatRoundTrip) {
                           "(1.000001) can0 080#001122334455667788", "(1.000001) can0 180##0112", "garbage"})
     EXPECT_FALSE(parse_candump_line(bad, f)) << bad;
 }
+
+// Regressions found by fuzz_candump (docs/reliability.md): an interface name holding NUL
+// bytes parsed, but the formatter stopped at the NUL and wrote a line that did not parse
+// back (input kept as fuzz/corpus/candump/regression-iface-nul); seconds of 10..12 digits
+// overflowed int64 nanoseconds.
+TEST(Candump, RegressionInterfaceNameMustBePrintable) {
+  const unsigned char raw[] = {0x28, 0x33, 0x2e, 0x34, 0x39, 0x35, 0x35, 0x35, 0x35, 0x29, 0x20, 0x00, 0x40,
+                               0x60, 0x00, 0x00, 0xdf, 0x37, 0x37, 0x29, 0x20, 0x33, 0x33, 0x33, 0x23, 0x33,
+                               0x33, 0x33, 0x33, 0x36, 0x33, 0x20, 0x36, 0x36, 0x36, 0xdf, 0x33, 0x33, 0x33};
+  CanFrame f;
+  EXPECT_FALSE(parse_candump_line(std::string_view(reinterpret_cast<const char*>(raw), sizeof raw), f));
+  EXPECT_FALSE(parse_candump_line("(3.495555) vc\tan0 333#33", f));
+  EXPECT_FALSE(parse_candump_line("(3.495555) abcdefghijklmnop 333#33", f));  // 16 > IFNAMSIZ - 1
+  ASSERT_TRUE(parse_candump_line("(3.495555) abcdefghijklmno 333#33", f));
+  char buf[96];
+  EXPECT_EQ(format_candump_line(f, std::string_view("a\0b", 3), buf), 0u);
+  EXPECT_EQ(format_candump_line(f, "", buf), 0u);
+  const std::size_t n = format_candump_line(f, "abcdefghijklmno", buf);
+  EXPECT_EQ(std::string(buf, n), "(0000000003.495555) abcdefghijklmno 333#33\n");
+}
+
+TEST(Candump, RegressionSecondsBeyondInt64Nanoseconds) {
+  CanFrame f;
+  EXPECT_FALSE(parse_candump_line("(999999999999.000000) can0 080#", f));
+  EXPECT_FALSE(parse_candump_line("(9223372037.000000) can0 080#", f));
+  ASSERT_TRUE(parse_candump_line("(9000000000.999999) can0 080#", f));
+  EXPECT_EQ(f.t_ns, 9'000'000'000'999'999'000LL);
+}
+
+// can-utils' candump -l layout: seconds padded to 10 digits, RTR with its DLC ("123#R4").
+TEST(Candump, MatchesCanUtilsLayout) {
+  CanFrame f;
+  ASSERT_TRUE(parse_candump_line("(0000000001.000001) vcan0 123#R4", f));
+  EXPECT_TRUE(f.rtr);
+  EXPECT_EQ(f.len, 4);
+  char buf[96];
+  EXPECT_EQ(std::string(buf, format_candump_line(f, "vcan0", buf)), "(0000000001.000001) vcan0 123#R4\n");
+  ASSERT_TRUE(parse_candump_line("(0000000001.000001) vcan0 123#R", f));
+  EXPECT_EQ(f.len, 0);
+  EXPECT_EQ(std::string(buf, format_candump_line(f, "vcan0", buf)), "(0000000001.000001) vcan0 123#R\n");
+  EXPECT_FALSE(parse_candump_line("(0000000001.000001) vcan0 123#R9", f));
+  EXPECT_FALSE(parse_candump_line("(0000000001.000001) vcan0 123#RR", f));
+  ASSERT_TRUE(parse_candump_line("(1700000000.000500) vcan0 12345678#DEADBEEF", f));
+  EXPECT_EQ(std::string(buf, format_candump_line(f, "vcan0", buf)), "(1700000000.000500) vcan0 12345678#DEADBEEF\n");
+}
+
+// An outage longer than a turn of the SYNC counter (240 SYNCs) hid whole turns: seen under
+// load in the HIL bench (296 SYNCs missed, 56 counted). The SYNC times reveal them; a late
+// SYNC within the same turn does not add one.
+TEST(CanopenAssembler, SyncCounterTurnsHiddenByALongOutage) {
+  Rig r;
+  r.cycle(0, 10, 1, 1, 1);
+  r.cycle(297'000, 67, 2, 2, 2);  // 296 SYNCs missed: the counter shows 56
+  EXPECT_EQ(r.c.get(Fault::SeqGap), 296u);
+  ASSERT_EQ(r.got.size(), 2u);
+  EXPECT_EQ(r.got[1].seq - r.got[0].seq, 297u);
+  r.cycle(297'000 + 150'000, 68, 3, 3, 3);  // a SYNC 150 periods late, none missed
+  EXPECT_EQ(r.c.get(Fault::SeqGap), 296u);
+  r.cycle(297'000 + 150'000 + 481'000, 69, 4, 4, 4);  // 480 SYNCs (two whole turns) missed
+  EXPECT_EQ(r.c.get(Fault::SeqGap), 296u + 480u);
+}

@@ -1,14 +1,21 @@
 // Serial frame decoder: CRC check value, golden frame, and every fault kind (bad CRC,
 // truncated, garbage prefix, bad length, sequence gap, duplicate, no-value pattern,
-// out-of-range and jump rejection), resynchronisation inside a damaged frame.
+// out-of-range and jump rejection), resynchronisation inside a damaged frame; the serial
+// source's hang-up / reconnect over a pseudo-terminal.
 #include <gtest/gtest.h>
+#include <pty.h>
+#include <termios.h>
+#include <unistd.h>
 
 #include <cstring>
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "hal/crc.hpp"
 #include "hal/serial_codec.hpp"
+#include "hal/source.hpp"
 #include "hal/validate.hpp"
 
 using namespace lbr::hal;
@@ -201,4 +208,135 @@ TEST(Validator, OutOfRangeAndJumpRejected) {
   EXPECT_FALSE(v.accept(s, c));
   EXPECT_EQ(c.get(Fault::OutOfRange), 2u);
   EXPECT_EQ(v.rejected(), 3u);
+}
+
+// live.serial.reconnect_ms: a hang-up (the pty master closed, the link gone) does not end the
+// source; a new pty behind the same link is reopened, counted `reconnect`, and the frames
+// missed meanwhile count as sequence gaps. With 0 the hang-up ends the source.
+namespace {
+
+struct PtyLink {
+  int master = -1;
+  PtyLink(const std::string& link) {
+    int slave = -1;
+    EXPECT_EQ(openpty(&master, &slave, nullptr, nullptr, nullptr), 0);
+    termios t{};
+    tcgetattr(slave, &t);
+    cfmakeraw(&t);
+    tcsetattr(slave, TCSANOW, &t);
+    std::filesystem::remove(link);
+    std::filesystem::create_symlink(ttyname(slave), link);
+    ::close(slave);
+  }
+  void send(const std::vector<std::uint8_t>& b) const { ASSERT_EQ(::write(master, b.data(), b.size()), static_cast<ssize_t>(b.size())); }
+  void hang_up(const std::string& link) {
+    std::filesystem::remove(link);
+    ::close(master);
+    master = -1;
+  }
+  ~PtyLink() {
+    if (master >= 0) ::close(master);
+  }
+};
+
+struct CountingSink final : SampleSink {
+  std::vector<std::uint64_t> seqs;
+  void on_samples(std::span<const AxisSample> s) noexcept override {
+    for (const AxisSample& a : s) seqs.push_back(a.seq);
+  }
+};
+
+// Polls until `want` samples arrived or the source ends / 2 s pass; returns the last result.
+PollResult poll_for(Source& src, CountingSink& sink, std::size_t want) {
+  PollResult r = PollResult::Idle;
+  for (int i = 0; i < 200 && sink.seqs.size() < want && r != PollResult::End; ++i) r = src.poll(10, sink);
+  return r;
+}
+
+}  // namespace
+
+TEST(SerialSource, ReconnectsAfterHangUpAndCountsTheGap) {
+  const std::string dir = testing::TempDir() + "/lbr_serial_reconnect";
+  std::filesystem::create_directories(dir);
+  const std::string link = dir + "/pty";
+  LiveConfig cfg;
+  cfg.axes = default_axes();
+  cfg.serial.reconnect_ms = 20.0;
+  auto pty = std::make_unique<PtyLink>(link);
+  auto src = make_serial_source(link, cfg);
+  src->open();
+  CountingSink sink;
+  for (std::uint32_t s = 0; s < 5; ++s) pty->send(frame(s, {1, 2, 3}));
+  pty->send({0xA5, 0x5A, 0x18, 0x05});  // the start of frame 5, cut by the hang-up
+  EXPECT_NE(poll_for(*src, sink, 5), PollResult::End);
+  ASSERT_EQ(sink.seqs.size(), 5U);
+  pty->hang_up(link);
+  for (int i = 0; i < 5; ++i) EXPECT_NE(src->poll(10, sink), PollResult::End);  // waits for the device
+  pty = std::make_unique<PtyLink>(link);
+  for (std::uint32_t s = 9; s < 12; ++s) pty->send(frame(s, {1, 2, 3}));
+  EXPECT_NE(poll_for(*src, sink, 8), PollResult::End);
+  EXPECT_EQ(sink.seqs, (std::vector<std::uint64_t>{0, 1, 2, 3, 4, 9, 10, 11}));
+  EXPECT_EQ(src->counters().get(Fault::Reconnect), 1U);
+  EXPECT_EQ(src->lost(), 4U);  // 5, 6, 7, 8
+  EXPECT_EQ(src->counters().get(Fault::SeqGap), 4U);
+  src->close();
+}
+
+TEST(SerialSource, HangUpEndsTheSourceWithoutReconnect) {
+  const std::string dir = testing::TempDir() + "/lbr_serial_hangup";
+  std::filesystem::create_directories(dir);
+  const std::string link = dir + "/pty";
+  LiveConfig cfg;
+  cfg.axes = default_axes();
+  PtyLink pty(link);
+  auto src = make_serial_source(link, cfg);
+  src->open();
+  CountingSink sink;
+  for (std::uint32_t s = 0; s < 3; ++s) pty.send(frame(s, {1, 2, 3}));
+  EXPECT_NE(poll_for(*src, sink, 3), PollResult::End);
+  pty.hang_up(link);
+  EXPECT_EQ(poll_for(*src, sink, 100), PollResult::End);
+  EXPECT_EQ(sink.seqs.size(), 3U);
+  EXPECT_EQ(src->counters().get(Fault::Reconnect), 0U);
+}
+
+// Regression (UBSan in fuzz_serial, docs/reliability.md): a frame's 64-bit t_us × 1000
+// overflowed int64. Wire timestamps beyond kMaxSerialTimeUs are invalid values now.
+TEST(SerialMapping, RegressionTimestampBeyondInt64Nanoseconds) {
+  LiveConfig cfg;
+  cfg.axes = default_axes();
+  std::array<AxisSample, kMaxChannels> out{};
+  Counters c;
+  SerialFrame f;
+  f.seq = 1;
+  f.n = 3;
+  f.pos = {1, 2, 3};
+  f.t_us = kMaxSerialTimeUs + 1;
+  EXPECT_EQ(frame_to_samples(f, cfg, 0, out, c), 0);
+  EXPECT_EQ(c.get(Fault::InvalidValue), 1u);
+  f.t_us = ~std::uint64_t{0};
+  EXPECT_EQ(frame_to_samples(f, cfg, 0, out, c), 0);
+  f.t_us = kMaxSerialTimeUs;
+  ASSERT_EQ(frame_to_samples(f, cfg, 0, out, c), 1);
+  EXPECT_EQ(out[0].t_src_ns, static_cast<std::int64_t>(kMaxSerialTimeUs) * 1000);
+}
+
+// The 32-bit serial sequence wraps: the jump check takes the step modulo 2^32 (before, the
+// wrap looked like 2^64 − 2^32 periods and let any jump through).
+TEST(Validator, SequenceWrapIsOnePeriod) {
+  LiveConfig cfg;
+  cfg.axes = default_axes();
+  for (auto& m : cfg.axes) m.max_speed_per_s = 100.0;
+  Validator v(cfg);
+  Counters c;
+  AxisSample s;
+  s.mask = 0b111;
+  s.seq = 0xFFFFFFFFu;
+  EXPECT_TRUE(v.accept(s, c));
+  s.seq = 0;
+  s.q[0] = 50.0;  // 50 mm in one period
+  EXPECT_FALSE(v.accept(s, c));
+  EXPECT_EQ(c.get(Fault::Jump), 1u);
+  s.q[0] = 0.1;
+  EXPECT_TRUE(v.accept(s, c));
 }

@@ -44,6 +44,21 @@ TEST(LatencyHistogram, NegativeCountsAsZero) {
   EXPECT_EQ(h.percentile_ns(0.5), 0);
 }
 
+// Windows (the status line's "p99 since last line", tools/soak.sh): the percentile of what
+// was recorded between two copies of the counts, not of the whole run.
+TEST(LatencyHistogram, PercentileBetweenTwoCopies) {
+  LatencyHistogram h;
+  for (int i = 0; i < 1000; ++i) h.record(1'000'000);  // 1 ms
+  LatencyHistogram::Counts before{}, after{};
+  h.copy_counts(before);
+  for (int i = 0; i < 100; ++i) h.record(50'000'000);  // then 100 values of 50 ms
+  h.copy_counts(after);
+  const double p99 = static_cast<double>(LatencyHistogram::percentile_between_ns(before, after, 0.99));
+  EXPECT_NEAR(p99, 50e6, 50e6 / 32);
+  EXPECT_NEAR(static_cast<double>(h.percentile_ns(0.5)), 1e6, 1e6 / 32);  // the whole run: still 1 ms
+  EXPECT_EQ(LatencyHistogram::percentile_between_ns(after, after, 0.99), 0);  // empty window
+}
+
 TEST(RtThread, FifoOrNonRtWithMinimalSlack) {
   std::atomic<int> mode{-1};
   std::atomic<long> slack{-1};

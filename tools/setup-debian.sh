@@ -22,6 +22,8 @@ PACKAGES=(
   clang
   # HIL bench (tools/hil/hil-bench.sh): VM with Debian's kernel, vcan, busybox initramfs
   qemu-system-x86 busybox-static cpio
+  # ... which also drives lbrsim from can-utils (candump -l, canplayer) inside the VM
+  can-utils
   # LinuxCNC's rs274 interpreter: optional at run time (lbrsim --interpreter rs274), needed for
   # the rs274 cross-check tests (they skip without it)
   linuxcnc-uspace

@@ -653,6 +653,9 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_option("--snapshot-dir", ro.snapshot_dir,
                   "Folder of the power-loss snapshots (profile [live] snapshot_s); default: the --out folder");
   run->add_flag("--quiet", ro.quiet, "No status lines");
+  run->add_option("--status-every", ro.live.status_period_s, "Seconds between status lines (each gives the lag p99 since the last)")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
   run->add_flag("--no-window", ro.no_window, "Do not open the viewer even when a display exists");
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
   run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "

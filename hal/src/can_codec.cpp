@@ -1,5 +1,7 @@
 #include "hal/can_codec.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -19,6 +21,14 @@ int hexval(char ch) noexcept {
 
 constexpr std::uint32_t kErrFlag = 0x20000000U;
 
+// A Linux interface name as candump writes it: 1..15 printable characters, no space.
+bool valid_iface(std::string_view s) noexcept {
+  if (s.empty() || s.size() > 15) return false;
+  for (const char ch : s)
+    if (ch < 0x21 || ch > 0x7E) return false;
+  return true;
+}
+
 }  // namespace
 
 bool parse_candump_line(std::string_view s, CanFrame& f, std::string_view* iface) noexcept {
@@ -31,6 +41,7 @@ bool parse_candump_line(std::string_view s, CanFrame& f, std::string_view* iface
     if (++nd > 12) return false;
     sec = sec * 10 + (s[i++] - '0');
   }
+  if (sec > kMaxCandumpSec) return false;  // t_ns below must fit in int64
   if (nd == 0 || i >= s.size() || s[i++] != '.') return false;
   nd = 0;
   while (i < s.size() && s[i] >= '0' && s[i] <= '9') {
@@ -41,7 +52,7 @@ bool parse_candump_line(std::string_view s, CanFrame& f, std::string_view* iface
   if (i >= s.size() || s[i++] != ' ') return false;
   const std::size_t if0 = i;
   while (i < s.size() && s[i] != ' ') ++i;
-  if (i == if0 || i >= s.size()) return false;
+  if (i >= s.size() || !valid_iface(s.substr(if0, i - if0))) return false;
   if (iface != nullptr) *iface = s.substr(if0, i - if0);
   ++i;
   const std::size_t id0 = i;
@@ -64,9 +75,10 @@ bool parse_candump_line(std::string_view s, CanFrame& f, std::string_view* iface
   if (!f.ext && id > 0x7FF) return false;
   f.id = f.ext ? (id & 0x1FFFFFFFU) : id;
   if (i < s.size() && s[i] == '#') return false;  // CAN FD: not supported
-  if (i < s.size() && s[i] == 'R') {
+  if (i < s.size() && s[i] == 'R') {  // RTR, optionally with its DLC (candump: "123#R4")
     f.rtr = true;
-    return true;
+    if (++i < s.size() && s[i] >= '0' && s[i] <= '8') f.len = static_cast<std::uint8_t>(s[i++] - '0');
+    return i >= s.size() || s[i] == '\r' || s[i] == '\n' || s[i] == ' ';
   }
   std::size_t n = 0;
   while (i < s.size() && s[i] != '\r' && s[i] != '\n' && s[i] != ' ') {
@@ -81,17 +93,24 @@ bool parse_candump_line(std::string_view s, CanFrame& f, std::string_view* iface
 }
 
 std::size_t format_candump_line(const CanFrame& f, std::string_view iface, std::span<char> out) noexcept {
+  if (!valid_iface(iface) || f.t_ns < 0 || f.len > 8) return 0;
   char data[17] = {};
-  for (int k = 0; k < f.len && k < 8; ++k) std::snprintf(data + 2 * k, 3, "%02X", f.data[static_cast<std::size_t>(k)]);
+  if (f.rtr) {  // candump: "R", then the DLC when it is not 0
+    data[0] = 'R';
+    if (f.len > 0) data[1] = static_cast<char>('0' + f.len);
+  } else {
+    for (int k = 0; k < f.len; ++k) std::snprintf(data + 2 * k, 3, "%02X", f.data[static_cast<std::size_t>(k)]);
+  }
   const long long sec = f.t_ns / 1'000'000'000, usec = (f.t_ns % 1'000'000'000) / 1000;
   int n;
   const int ilen = static_cast<int>(iface.size());
+  // candump -l: seconds zero-padded to 10 digits, ids upper-case hex.
   if (f.ext || f.err)
-    n = std::snprintf(out.data(), out.size(), "(%lld.%06lld) %.*s %08X#%s\n", sec, usec, ilen, iface.data(),
-                      f.id | (f.err ? kErrFlag : 0U), f.rtr ? "R" : data);
+    n = std::snprintf(out.data(), out.size(), "(%010lld.%06lld) %.*s %08X#%s\n", sec, usec, ilen, iface.data(),
+                      f.id | (f.err ? kErrFlag : 0U), data);
   else
-    n = std::snprintf(out.data(), out.size(), "(%lld.%06lld) %.*s %03X#%s\n", sec, usec, ilen, iface.data(), f.id,
-                      f.rtr ? "R" : data);
+    n = std::snprintf(out.data(), out.size(), "(%010lld.%06lld) %.*s %03X#%s\n", sec, usec, ilen, iface.data(), f.id,
+                      data);
   return n > 0 && static_cast<std::size_t>(n) < out.size() ? static_cast<std::size_t>(n) : 0;
 }
 
@@ -117,6 +136,16 @@ CanopenAssembler::CanopenAssembler(const LiveConfig& cfg) : cfg_(cfg) {
     ++mapped_;
   }
   late_ns_ = static_cast<std::int64_t>((cfg_.can.late_ms > 0 ? cfg_.can.late_ms : 0.8 * cfg_.period_ms) * 1e6);
+  period_ns_ = cfg_.period_ms * 1e6;
+}
+
+std::uint64_t CanopenAssembler::hidden_turns(std::int64_t t_ns, std::uint64_t gap) const noexcept {
+  if (period_ns_ <= 0 || t_ns <= last_sync_t_) return 0;
+  // Both times lie in [0, 9e18] ns (parse_candump_line, kernel timestamps): no overflow.
+  const double missing = static_cast<double>(t_ns - last_sync_t_) / period_ns_ - 1.0;
+  const auto max = static_cast<double>(cfg_.can.sync_counter_max);
+  const double turns = std::floor((missing - static_cast<double>(gap)) / max + 0.1);
+  return turns >= 1.0 ? static_cast<std::uint64_t>(std::min(turns, 1e6)) * static_cast<std::uint64_t>(max) : 0;
 }
 
 void CanopenAssembler::close_cycle(Counters& c) noexcept {
@@ -149,14 +178,16 @@ int CanopenAssembler::on_frame(const CanFrame& f, std::int64_t now_mono_ns, std:
       const int max = cfg_.can.sync_counter_max;
       if (last_counter_ >= 0) {
         const int expected = last_counter_ % max + 1;
-        const int gap = ((counter - expected) % max + max) % max;
+        auto gap = static_cast<std::uint64_t>(((counter - expected) % max + max) % max);
+        gap += hidden_turns(f.t_ns, gap);
         if (gap > 0) {
-          c.add(Fault::SeqGap, static_cast<std::uint64_t>(gap));
-          lost_ += static_cast<std::uint64_t>(gap);
-          step += static_cast<std::uint64_t>(gap);
+          c.add(Fault::SeqGap, gap);
+          lost_ += gap;
+          step += gap;
         }
       }
       last_counter_ = counter;
+      last_sync_t_ = f.t_ns;
     }
     seq_ += step;
     open_ = true;

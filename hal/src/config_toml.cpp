@@ -18,7 +18,10 @@ void read_live_keys(cfg::Table& s, LiveConfig& c) {
   c.snapshot_s = s.number("snapshot_s", 5.0, 0.0, 86400.0, "s");  // app/snapshot.hpp
 }
 
-void read_serial(cfg::Table& s, SerialConfig& c) { c.baud = static_cast<int>(s.integer("baud", 115200, 1200, 4000000)); }
+void read_serial(cfg::Table& s, SerialConfig& c) {
+  c.baud = static_cast<int>(s.integer("baud", 115200, 1200, 4000000));
+  c.reconnect_ms = s.number("reconnect_ms", 0.0, 0.0, 60000.0, "ms");
+}
 
 void read_can(cfg::Table& s, CanConfig& c) {
   c.sync_id = static_cast<std::uint32_t>(s.integer("sync_id", 0x080, 0, 0x7FF));

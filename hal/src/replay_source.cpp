@@ -1,6 +1,7 @@
 // ReplaySource: candump -l logs (CAN) and recorded serial captures, paced by their
 // timestamps (speed × real time) or as fast as possible (speed 0). The whole log is parsed
 // in open(), so the HAL loop does no file I/O.
+#include <algorithm>
 #include <fstream>
 #include <stdexcept>
 #include <vector>
@@ -70,7 +71,10 @@ class ReplaySource final : public Source {
     if (next_ >= recs_.size()) return PollResult::End;
     const Rec& r = recs_[next_];
     if (speed_ > 0.0) {
-      const auto due = t0_mono_ + static_cast<std::int64_t>(static_cast<double>(r.t_ns - t0_log_) / speed_);
+      // Log times are in [0, kMaxCandumpSec] s, so the difference fits; the quotient is
+      // clamped (a tiny --speed would overflow int64).
+      const double wait_ns = std::clamp(static_cast<double>(r.t_ns - t0_log_) / speed_, 0.0, 1e17);
+      const auto due = t0_mono_ + static_cast<std::int64_t>(wait_ns);
       const std::int64_t now = sched::now_ns();
       if (due > now) {
         const std::int64_t limit = now + static_cast<std::int64_t>(timeout_ms) * 1'000'000;

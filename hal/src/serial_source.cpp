@@ -1,12 +1,16 @@
 // SerialSource: LibSerial opens and configures the port (8N1, raw, baud from the profile);
 // we then take over a duplicate of its descriptor with those settings and close the
 // LibSerial object. The HAL loop uses poll()+read(), because LibSerial reports timeouts
-// (and a hung-up port on close) with exceptions and the RT path must not throw.
+// (and a hung-up port on close) with exceptions and the RT path must not throw. With
+// live.serial.reconnect_ms > 0 a hang-up closes the descriptor and poll() reopens the path
+// with plain open() + the saved termios (no allocation) until it comes back.
+#include <fcntl.h>
 #include <poll.h>
 #include <unistd.h>
 
 #include <termios.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -45,6 +49,7 @@ class SerialSource final : public Source {
     if (cfg_.axes.empty()) cfg_.axes = default_axes();
     baud_ = baud_of(cfg_.serial.baud);
     needed_ = serial_positions_needed(cfg_);
+    reconnect_ns_ = static_cast<std::int64_t>(cfg_.serial.reconnect_ms * 1e6);
   }
   ~SerialSource() override { close(); }
 
@@ -83,11 +88,55 @@ class SerialSource final : public Source {
       ::close(fd);
       throw std::runtime_error("serial:" + dev_ + ": tcsetattr: " + std::strerror(e));
     }
+    settings_ = settings;
     fd_ = fd;
   }
 
   PollResult poll(int timeout_ms, SampleSink& sink) noexcept override {
-    if (fd_ < 0) return PollResult::End;
+    if (fd_ < 0) return reconnect_ns_ > 0 ? try_reopen(timeout_ms) : PollResult::End;
+    const PollResult r = read_and_decode(timeout_ms, sink);
+    if (r != PollResult::End || reconnect_ns_ <= 0) return r;
+    hang_up();  // live.serial.reconnect_ms: wait for the device to come back
+    return PollResult::Idle;
+  }
+
+  void close() noexcept override {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+  [[nodiscard]] std::string describe() const override { return "serial:" + dev_; }
+  [[nodiscard]] std::uint64_t lost() const noexcept override { return dec_.gaps() + mapped_lost_; }
+
+ private:
+  // The device hung up: close it and drop the partial frame; the sequence number is kept, so
+  // the frames missed until the reopen count as gaps.
+  void hang_up() noexcept {
+    close();
+    dec_.drop_partial();
+    retry_at_ns_ = sched::now_ns();
+  }
+
+  // Reopens the device (same path, the settings open() applied) once retry_at_ns_ is due;
+  // sleeps until then, at most timeout_ms. No allocation: plain open() + tcsetattr().
+  PollResult try_reopen(int timeout_ms) noexcept {
+    const std::int64_t now = sched::now_ns();
+    if (now < retry_at_ns_) {
+      sched::sleep_until_ns(std::min(retry_at_ns_, now + static_cast<std::int64_t>(timeout_ms) * 1'000'000));
+      return PollResult::Idle;
+    }
+    retry_at_ns_ = now + reconnect_ns_;
+    const int fd = ::open(dev_.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+    if (fd < 0) return PollResult::Idle;
+    if (::tcsetattr(fd, TCSANOW, &settings_) != 0) {
+      ::close(fd);
+      return PollResult::Idle;
+    }
+    fd_ = fd;
+    counters_.add(Fault::Reconnect);
+    return PollResult::Idle;
+  }
+
+  PollResult read_and_decode(int timeout_ms, SampleSink& sink) noexcept {
     pollfd p{fd_, POLLIN, 0};
     const int r = ::poll(&p, 1, timeout_ms);
     if (r == 0) return PollResult::Idle;
@@ -129,14 +178,6 @@ class SerialSource final : public Source {
     return PollResult::Data;
   }
 
-  void close() noexcept override {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = -1;
-  }
-  [[nodiscard]] std::string describe() const override { return "serial:" + dev_; }
-  [[nodiscard]] std::uint64_t lost() const noexcept override { return dec_.gaps() + mapped_lost_; }
-
- private:
   std::string dev_;
   LiveConfig cfg_;
   LibSerial::BaudRate baud_;
@@ -146,6 +187,8 @@ class SerialSource final : public Source {
   std::array<AxisSample, kMaxChannels> out_{};
   std::uint64_t mapped_lost_ = 0;
   int needed_ = 0;
+  termios settings_{};
+  std::int64_t reconnect_ns_ = 0, retry_at_ns_ = 0;
 };
 
 }  // namespace

@@ -66,7 +66,9 @@ bool Validator::accept(const AxisSample& s, Counters& c) noexcept {
   }
   const auto& lim = lim_[s.channel];
   Ref& ref = ref_[s.channel];
-  const double dt = ref.have ? static_cast<double>(s.seq - ref.seq) * period_s_ : 0.0;
+  // Sequence numbers of serial frames are 32-bit on the wire: the step is taken modulo 2^32,
+  // so a wrap is one period and not 2^64 − 2^32 of them.
+  const double dt = ref.have ? static_cast<double>(static_cast<std::uint32_t>(s.seq - ref.seq)) * period_s_ : 0.0;
   for (int a = 0; a < kMaxAxes; ++a) {
     const Limit& l = lim[static_cast<std::size_t>(a)];
     if (!l.mapped || !(s.mask & (1U << a))) continue;
@@ -105,6 +107,10 @@ int frame_to_samples(const SerialFrame& f, const LiveConfig& cfg, std::int64_t n
   // cfg.axes is never empty: the profile fills default_axes() (no allocation here).
   const AxisMap* begin = cfg.axes.data();
   const std::size_t count = cfg.axes.size();
+  if (f.t_us > kMaxSerialTimeUs) {  // a wire value: t_src_ns below must fit in int64
+    c.add(Fault::InvalidValue);
+    return 0;
+  }
   for (std::size_t k = 0; k < count; ++k) {
     const AxisMap& m = begin[k];
     if (m.index >= f.n) {

@@ -75,4 +75,23 @@ std::int64_t LatencyHistogram::percentile_ns(double q) const noexcept {
   return max_ns();
 }
 
+void LatencyHistogram::copy_counts(Counts& out) const noexcept {
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = buckets_[i].load(std::memory_order_relaxed);
+}
+
+std::int64_t LatencyHistogram::percentile_between_ns(const Counts& before, const Counts& after, double q) noexcept {
+  std::uint64_t total = 0;
+  for (std::size_t i = 0; i < after.size(); ++i) total += after[i] - std::min(before[i], after[i]);
+  if (total == 0) return 0;
+  q = std::clamp(q, 0.0, 1.0);
+  const auto rank = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(total))));
+  std::uint64_t seen = 0;
+  for (int i = 0; i < kBuckets; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    seen += after[k] - std::min(before[k], after[k]);
+    if (seen >= rank) return static_cast<std::int64_t>(bucket_low(i) + (bucket_high(i) - 1 - bucket_low(i)) / 2);
+  }
+  return 0;
+}
+
 }  // namespace lbr::sched

@@ -4,10 +4,13 @@
 # initramfs holding lbrsim, lbr-feed-can, their shared libraries and the can, can-raw,
 # can-dev, vcan modules. In the VM: vcan0, `lbr-feed-can` (with injected faults) →
 # `lbrsim run --source can:vcan0 --record`, then a replay of the recorded candump log.
+# Debian's can-utils interoperate: `candump -l` records the feeder's frames during the live
+# run and its file is replayed (replay:); `canplayer` plays lbrsim's recording onto vcan0
+# for a second live run; both logs must agree line for line (candump's format).
 # The interface is taken down for 0.4 s mid-run (bus-off / interface-down detection and
 # reconnection). Checks: every injected fault counted, replay = live (samples, faults, volume).
 # Usage: tools/hil/hil-bench.sh [BUILD_DIR] [WORK_DIR]   (needs qemu-system-x86,
-# busybox-static, cpio; downloads the kernel package once into WORK_DIR with apt-get).
+# busybox-static, cpio, can-utils; downloads the kernel package once into WORK_DIR with apt-get).
 set -euo pipefail
 if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then  # usage: the comment above
   sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0
@@ -29,8 +32,8 @@ R="$WORK/root"
 rm -rf "$R"
 mkdir -p "$R"/{bin,sbin,proc,sys,dev,tmp,mods,data}
 cp "$(command -v busybox)" "$R/bin/busybox"
-for a in sh mount insmod ip poweroff cat sleep kill tr echo grep; do ln -sf busybox "$R/bin/$a"; done
-for b in "$BUILD/app/lbrsim" "$BUILD/tools/feeders/lbr-feed-can"; do
+for a in sh mount insmod ip poweroff cat sleep kill tr echo grep ls head mkdir gzip base64 sed; do ln -sf busybox "$R/bin/$a"; done
+for b in "$BUILD/app/lbrsim" "$BUILD/tools/feeders/lbr-feed-can" "$(command -v candump)" "$(command -v canplayer)"; do
   cp "$b" "$R/bin/"
   for lib in $(ldd "$b" | awk '/=>/ {print $3} /^[ \t]*\// {print $1}'); do
     mkdir -p "$R$(dirname "$lib")"
@@ -62,12 +65,13 @@ def get(tag):
             return l[i + len(tag) + 1:].strip()
     sys.exit(f"HIL: no {tag} line in the console log")
 if any("HIL-ERROR" in l for l in lines): sys.exit("HIL: setup error in the VM")
-feed, live, rep = (json.loads(get(t)) for t in ("HIL-FEED", "HIL-LIVE", "HIL-REPLAY"))
+feed, live, rep, rep_cd, play = (json.loads(get(t)) for t in ("HIL-FEED", "HIL-LIVE", "HIL-REPLAY", "HIL-CANDUMP-REPLAY", "HIL-PLAY"))
 errs = live["decode_errors"]
 fail = []
 def expect(cond, what):
     if not cond: fail.append(what)
-expect(get("HIL-LIVE-RC") == "0" and get("HIL-REPLAY-RC") == "0", "exit codes")
+expect(all(get(t) == "0" for t in ("HIL-LIVE-RC", "HIL-REPLAY-RC", "HIL-CANDUMP-REPLAY-RC", "HIL-CANPLAYER-RC", "HIL-PLAY-RC")),
+       "exit codes")
 # The corrupted TPDOs are length errors; every SYNC yields a sample or a lost cycle
 # (the last cycle may stay open). Under TCG on a loaded host the VM can stall between a SYNC
 # and its TPDOs, so late TPDOs (counted, cycle lost) are possible: lost cycles are at least
@@ -94,6 +98,42 @@ for k, v in errs.items():
         expect(rep["decode_errors"][k] == v, f"replay decode_errors.{k}")
 a, b = live["removed_volume_mm3"], rep["removed_volume_mm3"]
 expect(abs(a - b) <= 5e-5 * abs(a) and a > 1000, f"volume live {a} replay {b}")
+# can-utils. The two logs: every line matches candump -l's layout, and lbrsim's recording
+# (timestamps aside) is candump's file in order, less what lbrsim missed while reconnecting.
+import base64, gzip, re
+logs = {t: gzip.decompress(base64.b64decode(get(t))).decode().splitlines() for t in ("HIL-LOG-LBRSIM", "HIL-LOG-CANDUMP")}
+shape = re.compile(r"^\(\d{10}\.\d{6}\) vcan0 ([0-9A-F]{3}|[0-9A-F]{8})#([0-9A-F]{2}){0,8}$")
+for t, ls in logs.items():
+    bad = [l for l in ls if not shape.match(l)]
+    expect(not bad and ls, f"{t}: {len(bad)} of {len(ls)} lines not in candump -l layout, e.g. {bad[:2]}")
+ours, theirs = ([l.split(" ", 1)[1] for l in ls] for ls in (logs["HIL-LOG-LBRSIM"], logs["HIL-LOG-CANDUMP"]))
+j = 0
+for l in ours:
+    while j < len(theirs) and theirs[j] != l: j += 1
+    j += 1
+expect(j <= len(theirs), "lbrsim's recording is not candump's file in order")
+missed = len(theirs) - len(ours)
+expect(missed >= 0, f"lbrsim recorded {-missed} frames more than candump")
+# candump's file holds what the feeder sent (less the frames sent while the interface was
+# down, which the SYNC counter counts): the same accounting as the live run, and the volume.
+cd_err = rep_cd["decode_errors"]
+expect(feed["corrupted"] - 3 <= cd_err["length"] <= feed["corrupted"], f"candump replay length {cd_err['length']}")
+expect(0 <= feed["syncs"] - (rep_cd["samples_received"] + rep_cd["samples_lost"]) <= 1, "candump replay: syncs = samples + lost")
+# Volume: candump keeps listening while lbrsim reconnects after the interface comes back,
+# so its file can hold cycles lbrsim never saw; only when it holds no more (all but a
+# cycle's frames) must the volumes agree.
+c = rep_cd["removed_volume_mm3"]
+if missed <= 4:
+    expect(abs(c - a) <= 5e-5 * abs(a), f"volume candump replay {c} live {a}")
+# canplayer → lbrsim: the recorded samples again. canplayer sends what is due every 1 ms
+# (-g), so the play run's profile allows TPDOs 50 ms after their SYNC (init.sh).
+p = play["removed_volume_mm3"]
+expect(abs(p - a) <= 1e-3 * abs(a), f"volume canplayer {p} live {a}")
+late = play["decode_errors"]["late_tpdo"] + errs["late_tpdo"]
+expect(abs(play["samples_received"] - live["samples_received"]) <= late + 2, f"canplayer samples {play['samples_received']} live {live['samples_received']}")
+print(f"HIL can-utils: candump -l {len(theirs)} frames (lbrsim recorded {len(ours)}), replay {rep_cd['samples_received']} "
+      f"samples + {rep_cd['samples_lost']} lost, volume {c:.3f}; canplayer -> lbrsim {play['samples_received']} samples "
+      f"({play['decode_errors']['late_tpdo']} late TPDOs), volume {p:.3f}")
 print(f"HIL: {feed['samples']} samples over vcan0, lost {live['samples_lost']} (injected "
       f"{feed['dropped']} dropped + {feed['corrupted']} corrupted, {errs['late_tpdo']} late TPDOs, {down} SYNCs while "
       f"down, bus_off {errs['bus_off']}, reconnect {errs['reconnect']}), duplicates {errs['duplicate_tpdo']}, "

@@ -63,6 +63,7 @@ struct LivePipeline::Impl {
   std::atomic<std::int64_t> stop_ns{0}, geo_end_ns{0};
   std::atomic<std::uint64_t> hal_abandoned{0};
   std::int64_t t0 = 0;
+  sched::LatencyHistogram::Counts lag_at_last_line{};  // status_line(): the lag since the previous line
   std::thread hal, geometry, recorder;
   bool stopped = false;
   LiveProgress own_progress;  // when the caller gives none
@@ -77,7 +78,7 @@ std::size_t write_record_line(std::FILE* f, const hal::RawRecord& r, const std::
   char line[256];
   if (r.serial) {
     const long long sec = r.t_wall_ns / 1'000'000'000, usec = (r.t_wall_ns % 1'000'000'000) / 1000;
-    int n = std::snprintf(line, sizeof line, "(%lld.%06lld) serial #", sec, usec);
+    int n = std::snprintf(line, sizeof line, "(%010lld.%06lld) serial #", sec, usec);
     for (std::uint16_t i = 0; i < r.len && n + 3 < static_cast<int>(sizeof line); ++i)
       n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), "%02X", r.bytes[i]);
     std::fputs(line, f);
@@ -402,13 +403,19 @@ std::string LivePipeline::status_line() {
   Impl& p = *impl_;
   snapshot(p);
   const LiveResult& r = *p.r;
-  char line[400];
+  sched::LatencyHistogram::Counts now{};
+  p.geo->lag().copy_counts(now);
+  const double window_p99_ms =
+      static_cast<double>(sched::LatencyHistogram::percentile_between_ns(p.lag_at_last_line, now, 0.99)) * 1e-6;
+  p.lag_at_last_line = now;
+  char line[440];
   std::snprintf(line, sizeof line,
                 "t %.1f s | rx %" PRIu64 " applied %" PRIu64 " lost %" PRIu64 " | ring hw %" PRIu64 "/%zu overruns %" PRIu64
-                " | coalesced %" PRIu64 " held %" PRIu64 " | lag p50 %.2f p99 %.2f max %.2f ms | removed %.1f mm3 | errors %" PRIu64,
+                " | coalesced %" PRIu64 " held %" PRIu64 " | lag p50 %.2f p99 %.2f max %.2f ms, p99 since last line %.2f ms"
+                " | removed %.1f mm3 | errors %" PRIu64,
                 static_cast<double>(sched::now_ns() - p.t0) * 1e-9, r.samples_received, r.samples_applied, r.samples_lost,
                 r.ring_high_water, p.ring->capacity(), r.ring_overruns, r.samples_coalesced, p.sink->held(), r.lag_p50_ms,
-                r.lag_p99_ms, r.lag_max_ms,
+                r.lag_p99_ms, r.lag_max_ms, window_p99_ms,
                 r.removed_volume_mm3, p.src->counters().total() + p.sink->counters().total());
   return line;
 }

@@ -25,10 +25,15 @@ struct CanFrame {
   std::int64_t t_ns = 0;  // receive time (kernel timestamp or log time) [ns]
 };
 
-// Parses one candump -l line "(SEC.USEC) IFACE ID#HEXDATA" (also ID#R for RTR, 8-digit ids
-// are extended, error frames carry the 0x20000000 flag). Pure; false on malformed lines.
+// Parses one candump -l line "(SEC.USEC) IFACE ID#HEXDATA" (also ID#R or ID#R<DLC> for RTR,
+// 8-digit ids are extended, error frames carry the 0x20000000 flag). IFACE: 1..15 printable
+// characters; SEC at most kMaxCandumpSec (so the time fits in int64 ns). Pure; false on
+// malformed lines.
+inline constexpr std::int64_t kMaxCandumpSec = 9'000'000'000;  // year 2255
 [[nodiscard]] bool parse_candump_line(std::string_view line, CanFrame& f, std::string_view* iface = nullptr) noexcept;
-// Formats a frame the way candump -l does; returns the length written (0 if `out` is too small).
+// Formats a frame the way candump -l does ("(%010lu.%06lu) IFACE ID#DATA"); returns the
+// length written, 0 if `out` is too small, the interface name is not one parse_candump_line
+// accepts, t_ns is negative or len > 8.
 std::size_t format_candump_line(const CanFrame& f, std::string_view iface, std::span<char> out) noexcept;
 
 class CanopenAssembler {
@@ -44,11 +49,15 @@ class CanopenAssembler {
 
   [[nodiscard]] std::uint64_t syncs() const noexcept { return syncs_; }
   [[nodiscard]] std::uint64_t samples() const noexcept { return samples_; }
-  // Cycles that never completed plus cycles skipped by the SYNC counter.
+  // Cycles that never completed plus cycles skipped by the SYNC counter. The counter repeats
+  // every sync_counter_max SYNCs; a silence of more than that (outage, bus-off, reconnect)
+  // hides whole turns of it, which the SYNC times reveal: whole turns are added when the
+  // time since the last SYNC exceeds the counter's gap by at least 0.9 of a turn.
   [[nodiscard]] std::uint64_t lost() const noexcept { return lost_; }
 
  private:
   void close_cycle(Counters& c) noexcept;
+  [[nodiscard]] std::uint64_t hidden_turns(std::int64_t t_ns, std::uint64_t gap) const noexcept;
 
   LiveConfig cfg_;
   std::array<std::int16_t, 128> node_map_{};  // node → index in cfg_.axes, -1 unmapped
@@ -63,6 +72,8 @@ class CanopenAssembler {
   int answered_count_ = 0;
   bool completed_ = false;
   int last_counter_ = -1;
+  std::int64_t last_sync_t_ = 0;
+  double period_ns_ = 1e6;
   std::uint64_t syncs_ = 0, samples_ = 0, lost_ = 0;
 };
 

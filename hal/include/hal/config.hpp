@@ -33,6 +33,7 @@ struct CanConfig {
 
 struct SerialConfig {
   int baud = 115200;
+  double reconnect_ms = 0.0;       // > 0: reopen the device this often after a hang-up; 0 = the run ends
 };
 
 struct LiveConfig {

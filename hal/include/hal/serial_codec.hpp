@@ -81,6 +81,9 @@ class SerialStreamDecoder {
   // Samples missing by sequence number so far (also counted as Fault::SeqGap).
   [[nodiscard]] std::uint64_t gaps() const noexcept { return gaps_; }
   void reset() noexcept { len_ = 0; have_seq_ = false; }
+  // Forgets buffered bytes (a partial frame of a stream that hung up); keeps the sequence
+  // number, so frames missed until the stream resumes count as gaps.
+  void drop_partial() noexcept { len_ = 0; }
 
  private:
   template <class F>

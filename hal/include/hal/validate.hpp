@@ -39,9 +39,13 @@ class Validator {
   std::uint64_t rejected_ = 0;
 };
 
+// Largest serial timestamp accepted [µs] (about 292 000 years): t_us × 1000 fits in int64.
+inline constexpr std::uint64_t kMaxSerialTimeUs = 9'223'372'036'854'775ULL;
+
 // Serial frame → one sample per mapped channel (mapping by AxisMap::index). Returns the
 // number written; 0 with Incomplete counted when the frame has too few positions, or with
-// InvalidValue counted when a mapped position holds 0x80000000. cfg.axes must not be empty.
+// InvalidValue counted when a mapped position holds 0x80000000 or t_us exceeds
+// kMaxSerialTimeUs. cfg.axes must not be empty.
 int frame_to_samples(const SerialFrame& f, const LiveConfig& cfg, std::int64_t now_mono_ns,
                      std::span<AxisSample, kMaxChannels> out, Counters& c) noexcept;
 

@@ -33,6 +33,12 @@ class LatencyHistogram {
   // clamped to [min, max]. 0 when empty.
   [[nodiscard]] std::int64_t percentile_ns(double q) const noexcept;
 
+  // Windows: copy the bucket counts now and then (any thread; relaxed reads); the quantile
+  // of the values recorded between two copies is the bucket midpoint, as above.
+  using Counts = std::array<std::uint64_t, kBuckets>;
+  void copy_counts(Counts& out) const noexcept;
+  [[nodiscard]] static std::int64_t percentile_between_ns(const Counts& before, const Counts& after, double q) noexcept;
+
   [[nodiscard]] static int bucket_of(std::uint64_t v) noexcept;
   [[nodiscard]] static std::uint64_t bucket_low(int b) noexcept;
   [[nodiscard]] static std::uint64_t bucket_high(int b) noexcept;  // exclusive
