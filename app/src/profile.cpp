@@ -501,6 +501,7 @@ Profile parse_profile(const std::string& text, const std::string& name) {
   if (const toml::table* rt = top.table("render")) {
     Section s(*rt, "render", name);
     p.render_rate_hz = s.number("rate_hz", 30.0, 1.0, 240.0, "Hz");
+    p.render_ui_scale = s.number("ui_scale", 1.5, 0.5, 4.0, "factor");
     s.reject_unknown();
   }
   top.reject_unknown();

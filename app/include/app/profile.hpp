@@ -50,6 +50,7 @@ struct Profile {
   int threads = 0;          // batch-mode kernel threads (0 = one per hardware thread)
   std::map<int, geom::Tool> tools;             // milling tools (spindle or live tools)
   double render_rate_hz = 30.0;  // [render] rate_hz: the render thread's fixed frame rate
+  double render_ui_scale = 1.5;  // [render] ui_scale: operator UI size factor (fonts, buttons)
   hal::LiveConfig live;     // [live], [[live.axis]], [threads]: `lbrsim run` (docs/profiles.md)
   // Machine kinematics ([machine] kind, rotary, ... in docs/profiles.md).
   kin::Kinematics kin;
