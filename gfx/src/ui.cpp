@@ -96,6 +96,9 @@ UiActions Ui::frame(const Renderer& ren, const UiFrameInput& in) {
   quit_dialog(in, act);
   ImGui::Render();
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  // Auto-sized windows are measured in their first frames (hidden, then placed): their
+  // rectangles are published from the third frame on.
+  if (ImGui::GetFrameCount() < 3) items_.clear();
   return act;
 }
 
