@@ -12,6 +12,8 @@ PACKAGES=(
   # libraries (found by CMake find_package / pkg-config)
   libpolyclipping-dev libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
   libglfw3-dev libx11-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev
+  # operator UI (Dear ImGui with its OpenGL 3 backend, docs/ui.md)
+  libimgui-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
   # independent mesh checker for the exported STL (tests/cli_mesh_admesh.cmake)

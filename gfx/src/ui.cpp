@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 
 #include <imgui.h>
@@ -59,14 +60,16 @@ Ui::~Ui() {
 void Ui::feed(std::deque<UiEvent>& queue) {
   ImGui::SetCurrentContext(ctx_);
   ImGuiIO& io = ImGui::GetIO();
-  std::array<bool, 3> changed{};
+  // One button change per frame, and no move after it: the frame must see the press (or
+  // release) where it happened, or a tap followed by a tap elsewhere would release on the
+  // second control.
+  bool button_changed = false;
   while (!queue.empty()) {
     const UiEvent& e = queue.front();
-    if (e.kind == UiEvent::Kind::Button) {
-      if (e.button < 0 || e.button > 2) { queue.pop_front(); continue; }
+    if (button_changed && e.kind != UiEvent::Kind::Scroll) break;
+    if (e.kind == UiEvent::Kind::Button && e.button >= 0 && e.button <= 2) {
       const auto b = static_cast<std::size_t>(e.button);
-      if (changed[b] && io.MouseDown[b] != e.down) break;  // next frame sees the release
-      changed[b] = true;
+      button_changed = io.MouseDown[b] != e.down;
       io.MouseDown[b] = e.down;
     } else if (e.kind == UiEvent::Kind::Scroll) {
       io.MouseWheel += static_cast<float>(e.wheel);
@@ -159,32 +162,47 @@ void Ui::status_bar(const Renderer& ren, const UiFrameInput& in) {
   if (error) ImGui::PopStyleColor();
 }
 
+// Text that continues the current line when it fits, or starts the next one (narrow panels).
+void Ui::flow(const ImVec4& colour, const char* fmt, ...) {
+  char buf[256];
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(buf, sizeof buf, fmt, args);
+  va_end(args);
+  if (!line_start_) {
+    ImGui::SameLine();
+    if (ImGui::CalcTextSize(buf).x > ImGui::GetContentRegionAvail().x) ImGui::NewLine();
+  }
+  ImGui::TextColored(colour, "%s", buf);
+  line_start_ = false;
+}
+
 // Source, connection, sample rate, lag, losses, ring, RT mode.
 void Ui::status_line_source(const Renderer& ren) {
   const LiveStats& L = ren.live();
-  ImGui::TextUnformatted(cfg_.source.empty() ? "source: -" : cfg_.source.c_str());
-  ImGui::SameLine();
+  line_start_ = true;
+  const ImVec4 white = ImGui::GetStyleColorVec4(ImGuiCol_Text);
+  flow(white, "%s", cfg_.source.empty() ? "source -" : cfg_.source.c_str());
   if (cfg_.replay != nullptr) {
     const bool paused = cfg_.replay->paused.load(std::memory_order_relaxed);
-    ImGui::TextColored(paused ? kAmber : kGreen, paused ? "| REPLAY PAUSED" : "| REPLAY");
+    flow(paused ? kAmber : kGreen, paused ? "| REPLAY PAUSED" : "| REPLAY");
   } else if (L.live) {
     const bool stale = since_data_s_ > 2.0;
-    ImGui::TextColored(stale ? kAmber : kGreen, stale ? "| LIVE: no data" : "| LIVE");
+    flow(stale ? kAmber : kGreen, stale ? "| LIVE: no data" : "| LIVE");
   } else {
-    ImGui::TextColored(kGrey, "| result (no live source)");
+    flow(kGrey, "| result (no live source)");
   }
   if (!L.live && L.samples == 0) return;
   lag_sorted_.assign(lag_ms_.begin(), lag_ms_.begin() + static_cast<std::ptrdiff_t>(lag_n_));
   std::sort(lag_sorted_.begin(), lag_sorted_.end());
   const unsigned long long lost = L.ring_overruns + L.decode_errors;
-  ImGui::SameLine();
-  ImGui::Text("| %.0f samples/s | lag %.1f ms (p50 %.1f, p99 %.1f) |", L.sample_rate_hz, L.lag_ms,
-              percentile_sorted(lag_sorted_, 0.5), percentile_sorted(lag_sorted_, 0.99));
-  ImGui::SameLine();
-  ImGui::TextColored(lost > 0 ? kAmber : kGrey, "lost %llu", lost);
-  ImGui::SameLine();
+  flow(white, "| %.0f samples/s", L.sample_rate_hz);
+  flow(white, "| lag %.1f ms (p50 %.1f, p99 %.1f)", L.lag_ms, percentile_sorted(lag_sorted_, 0.5),
+       percentile_sorted(lag_sorted_, 0.99));
+  flow(lost > 0 ? kAmber : white, "| lost %llu", lost);
   const double fill = L.ring_capacity ? static_cast<double>(L.ring_high_water) / static_cast<double>(L.ring_capacity) : 0.0;
-  ImGui::Text("| ring %.0f %% | %s", 100.0 * fill, L.realtime ? "RT (SCHED_FIFO)" : "non-RT");
+  flow(white, "| ring %.0f %%", 100.0 * fill);
+  flow(L.realtime ? kGreen : kGrey, "| %s", L.realtime ? "RT (SCHED_FIFO)" : "non-RT");
 }
 
 // Machining time and progress, tool, program line, frame figures.
@@ -200,24 +218,24 @@ void Ui::status_line_machining(const Renderer& ren) {
   } else {
     std::snprintf(overlay, sizeof overlay, "machining time -");
   }
-  ImGui::ProgressBar(frac, ImVec2(ImGui::GetFontSize() * 14, 0), overlay);
-  ImGui::SameLine();
+  ImGui::ProgressBar(frac, ImVec2(ImGui::GetFontSize() * 12, 0), overlay);
+  line_start_ = false;
+  const ImVec4 white = ImGui::GetStyleColorVec4(ImGuiCol_Text);
   const auto tools = ren.tools();
-  if (tools.empty() || tools.front().tool == 0) ImGui::TextUnformatted("| tool -");
-  else if (tools.size() == 1) ImGui::Text("| tool T%d  D%.2f mm", tools.front().tool, 2.0 * tools.front().radius_mm);
-  else ImGui::Text("| tools T%d + %zu more", tools.front().tool, tools.size() - 1);
-  ImGui::SameLine();
-  if (L.program_line > 0) ImGui::Text("| line %lld", static_cast<long long>(L.program_line));
-  else ImGui::TextUnformatted("| line -");
+  if (tools.empty() || tools.front().tool == 0) flow(white, "| tool -");
+  else if (tools.size() == 1) flow(white, "| tool T%d D%.2f mm", tools.front().tool, 2.0 * tools.front().radius_mm);
+  else flow(white, "| tools T%d + %zu more", tools.front().tool, tools.size() - 1);
+  if (L.program_line > 0) flow(white, "| line %lld", static_cast<long long>(L.program_line));
+  else flow(white, "| line -");
   const FrameInfo& f = ren.last_frame();
   const PacingInfo& p = ren.pacing();
-  ImGui::SameLine();
-  ImGui::TextColored(kGrey, "| frame %.1f ms, period p99 %.1f ms, late %llu, pending %d", p.frame_ms, p.p99_period_ms,
-                     static_cast<unsigned long long>(p.late_frames), f.step.regions_pending);
+  flow(kGrey, "| frame %.1f ms, period p99 %.1f ms, late %llu, pending %d", p.frame_ms, p.p99_period_ms,
+       static_cast<unsigned long long>(p.late_frames), f.step.regions_pending);
 }
 
 void Ui::alarms_line(const LiveStats& L) {
   const int n = std::min(L.alarm_count, kMaxAlarms);
+  line_start_ = true;
   if (n <= 0) {
     ImGui::TextColored(kGreen, "no alarms");
     return;
@@ -226,15 +244,14 @@ void Ui::alarms_line(const LiveStats& L) {
     const Alarm& a = L.alarms[static_cast<std::size_t>(i)];
     const char* tag = a.severity == AlarmSeverity::Error ? "ALARM" : (a.severity == AlarmSeverity::Warning ? "WARNING" : "INFO");
     const ImVec4 c = a.severity == AlarmSeverity::Error ? ImVec4(1, 1, 1, 1) : (a.severity == AlarmSeverity::Warning ? kAmber : kGrey);
-    if (i > 0) ImGui::SameLine();
-    ImGui::TextColored(c, "%s: %s", tag, a.text.data());
+    flow(c, "%s: %s", tag, a.text.data());
   }
 }
 
 // ---- view panel (right edge) -----------------------------------------------------------
 
 void Ui::view_panel(const UiFrameInput& in, UiActions& act) {
-  const float pw = ImGui::GetFontSize() * 9.5f;
+  const float pw = ImGui::GetFontSize() * 11.5f;
   const float max_h = std::max(100.0f, static_cast<float>(in.height) - status_h_);
   ImGui::SetNextWindowPos(ImVec2(static_cast<float>(in.width), 0), ImGuiCond_Always, ImVec2(1, 0));
   ImGui::SetNextWindowSizeConstraints(ImVec2(pw, 0), ImVec2(pw, max_h));

@@ -17,6 +17,7 @@
 
 struct ImGuiContext;
 struct ImVec2;
+struct ImVec4;
 
 namespace lbr::gfx::detail {
 
@@ -69,6 +70,7 @@ class Ui {
   void status_line_source(const Renderer& ren);
   void status_line_machining(const Renderer& ren);
   void alarms_line(const LiveStats& L);
+  void flow(const ImVec4& colour, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
   void view_panel(const UiFrameInput& in, UiActions& act);
   void view_buttons(UiActions& act);
   void display_toggles(UiActions& act);
@@ -86,6 +88,7 @@ class Ui {
   std::vector<UiRect> rects_;
   std::vector<std::pair<const char*, UiRect>> items_;
   bool modal_ = false;
+  bool line_start_ = true;     // flow(): the next text starts a line
   float status_h_ = 0;         // height of the status bar last frame [px]
   geom::Box3 stock_{};
   // Lag samples of the recent snapshots (p50/p99 in the status bar).
