@@ -50,7 +50,7 @@ bool is_background(const std::uint8_t* p) {  // the clear colour (0.13, 0.14, 0.
 class UiWindow {
  public:
   UiWindow(const geom::LbrSolid& solid, gfx::StandardView view, gfx::ReplayControl* replay = nullptr, int width = kW,
-           int height = kH) {
+           int height = kH, bool kiosk = false) {
     win_ = std::make_unique<gfx::Window>(width, height, true, "gfx_ui_test");
     gfx::RenderThreadConfig cfg;
     cfg.rate_hz = 20;
@@ -64,6 +64,7 @@ class UiWindow {
     cfg.ui.scale = 1.5f;
     cfg.ui.source = "gfx_ui_test";
     cfg.ui.replay = replay;
+    cfg.ui.kiosk = kiosk;
     rt_ = std::make_unique<gfx::RenderThread>(*win_, ex_, solid, cfg);
     router_ = std::make_unique<gfx::EventRouter>(*rt_, height);
     rt_->start();
@@ -72,9 +73,16 @@ class UiWindow {
 
   gfx::SolidExchange& exchange() { return ex_; }
   gfx::RenderThread& rt() { return *rt_; }
+  // Where `label` is drawn, once it stays in place from one frame to the next (windows that
+  // just appeared, like a dialog, are measured in their first frames).
   gfx::UiRect item(const std::string& label) {
-    gfx::UiRect r;
-    EXPECT_TRUE(wait_for([&] { return rt_->ui_item(label, r); })) << "the UI never drew '" << label << "'";
+    gfx::UiRect r, again;
+    EXPECT_TRUE(wait_for([&] {
+      if (!rt_->ui_item(label, r)) return false;
+      (void)rt_->capture(10.0);
+      return rt_->ui_item(label, again) && again.x0 == r.x0 && again.y0 == r.y0 && again.x1 == r.x1 &&
+             again.y1 == r.y1;
+    })) << "the UI never drew '" << label << "' in one place";
     return r;
   }
   // A one-finger tap at (x, y).
@@ -282,6 +290,19 @@ TEST_F(GfxUi, AnErrorAlarmTurnsTheStatusBarRed) {
   EXPECT_LT(r[1], 40);
   EXPECT_LT(r[2], 40);
   EXPECT_EQ(red.px(kW / 3, kH / 3)[0], calm.px(kW / 3, kH / 3)[0]);  // the 3D view is unchanged
+}
+
+TEST_F(GfxUi, KioskQuitNeedsTheConfirmation) {
+  UiWindow w(pocketed(), gfx::StandardView::Iso, nullptr, kW, kH, true);
+  (void)w.item("Quit...");
+  w.rt().ask_quit();  // Esc / Q / the window manager's close in kiosk mode
+  w.tap("Cancel");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_FALSE(w.rt().quit_confirmed());
+  EXPECT_FALSE(w.rt().ui_hit(300, 300));  // the dialog is gone: the 3D view takes presses again
+  w.tap("Quit...");
+  w.tap("Quit");
+  EXPECT_TRUE(wait_for([&] { return w.rt().quit_confirmed(); }));
 }
 
 // Not a check: with LBR_UI_SCREENSHOTS=DIR set, writes the pictures in docs/ui.md at the two

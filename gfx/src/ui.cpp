@@ -269,7 +269,7 @@ void Ui::view_panel(const UiFrameInput& in, UiActions& act) {
     section_controls(act);
     if (cfg_.kiosk) {
       ImGui::Separator();
-      if (button("Quit...", ImVec2(-1, b.y))) ImGui::OpenPopup("Quit lbrsim?");
+      if (button("Quit...", ImVec2(-1, b.y))) open_quit_ = true;  // opened at top level, where the dialog lives
     }
     remember_window();
   }
@@ -376,7 +376,8 @@ void Ui::replay_bar() {
 // ---- quit confirmation (kiosk) ---------------------------------------------------------
 
 void Ui::quit_dialog(const UiFrameInput& in, UiActions& act) {
-  if (in.ask_quit && !ImGui::IsPopupOpen("Quit lbrsim?")) ImGui::OpenPopup("Quit lbrsim?");
+  if ((in.ask_quit || open_quit_) && !ImGui::IsPopupOpen("Quit lbrsim?")) ImGui::OpenPopup("Quit lbrsim?");
+  open_quit_ = false;
   modal_ = false;
   const ImVec2 centre(0.5f * static_cast<float>(in.width), 0.5f * static_cast<float>(in.height));
   ImGui::SetNextWindowPos(centre, ImGuiCond_Always, ImVec2(0.5f, 0.5f));

@@ -88,6 +88,7 @@ class Ui {
   std::vector<UiRect> rects_;
   std::vector<std::pair<const char*, UiRect>> items_;
   bool modal_ = false;
+  bool open_quit_ = false;     // the panel's Quit... asks for the dialog
   bool line_start_ = true;     // flow(): the next text starts a line
   float status_h_ = 0;         // height of the status bar last frame [px]
   geom::Box3 stock_{};
