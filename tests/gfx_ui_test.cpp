@@ -242,8 +242,14 @@ TEST_F(GfxUi, PauseStopsTheRemovedVolumeFromGrowing) {
   ASSERT_TRUE(wait_for([&] { return !ctl.paused.load() && streamer.batches() > b0 + 5; }));
   ctl.speed.store(streamer.duration_s());  // the rest in about a second
   ASSERT_TRUE(wait_for([&] { return streamer.done(); }, 60.0));
+  EXPECT_LT(solid.volume_mm3(), v0 - 1.0);  // the streamer idles at the end: no subtract() runs
+  // Paused, Restart brings back the untouched stock (and nothing is cut again while paused).
+  w.tap("Pause");
+  ASSERT_TRUE(wait_for([&] { return ctl.paused.load(); }));
+  w.tap("Restart");
+  ASSERT_TRUE(wait_for([&] { return !streamer.done(); }));  // cleared once the stock is back
+  EXPECT_NEAR(solid.volume_mm3(), solid.initial_volume_mm3(), 1e-6 * solid.initial_volume_mm3());
   streamer.stop();
-  EXPECT_LT(solid.volume_mm3(), v0 - 1.0);
 }
 
 // Live counters with alarms, as the geometry side would publish them.
