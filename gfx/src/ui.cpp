@@ -154,7 +154,7 @@ void Ui::status_bar(const Renderer& ren, const UiFrameInput& in) {
   if (ImGui::Begin("##status", nullptr, kFixed | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoScrollbar)) {
     status_line_source(ren);
     status_line_machining(ren);
-    alarms_line(L);
+    alarms_line(L, in.opt.notice);
     remember_window();
     status_h_ = ImGui::GetWindowSize().y;
   }
@@ -233,10 +233,12 @@ void Ui::status_line_machining(const Renderer& ren) {
        static_cast<unsigned long long>(p.late_frames), f.step.regions_pending);
 }
 
-void Ui::alarms_line(const LiveStats& L) {
+void Ui::alarms_line(const LiveStats& L, const std::string& notice) {
   const int n = std::min(L.alarm_count, kMaxAlarms);
   line_start_ = true;
-  if (n <= 0) {
+  // The HUD's notice (e.g. live input that does not match the profile) as a warning.
+  if (!notice.empty()) flow(kAmber, "WARNING: %s", notice.c_str());
+  if (n <= 0 && notice.empty()) {
     ImGui::TextColored(kGreen, "no alarms");
     return;
   }

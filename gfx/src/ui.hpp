@@ -69,7 +69,7 @@ class Ui {
   void status_bar(const Renderer& ren, const UiFrameInput& in);
   void status_line_source(const Renderer& ren);
   void status_line_machining(const Renderer& ren);
-  void alarms_line(const LiveStats& L);
+  void alarms_line(const LiveStats& L, const std::string& notice);
   void flow(const ImVec4& colour, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
   void view_panel(const UiFrameInput& in, UiActions& act);
   void view_buttons(UiActions& act);
