@@ -14,6 +14,8 @@ PACKAGES=(
   libglfw3-dev libx11-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev libsystemd-dev
   # Debian package (cmake --build build --target package) and its checks (ctest -L package)
   lintian debootstrap
+  # operator UI (Dear ImGui with its OpenGL 3 backend, docs/ui.md)
+  libimgui-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox xvfb xauth
   # independent mesh checker for the exported STL (tests/cli_mesh_admesh.cmake)

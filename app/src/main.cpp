@@ -52,7 +52,7 @@ struct BatchOptions {
 };
 
 struct ViewCliOptions {
-  bool animate = false, hidden = false, ortho = false, no_vsync = false;
+  bool animate = false, hidden = false, ortho = false, no_vsync = false, no_ui = false, kiosk = false;
   double speed = 1.0, rate_hz = 30.0;
   int screenshot_every = 0;
   std::string screenshot_prefix = "lbrsim-frame-";  // view has no --out; .gitignore lists these
@@ -207,6 +207,8 @@ gfx::RenderThreadConfig render_config(const BatchOptions& o, const ViewCliOption
   rc.screenshot_every = v.screenshot_every;
   rc.screenshot_prefix = v.screenshot_prefix;
   rc.render.show_tools = !o.no_tool;
+  rc.ui.enabled = !v.no_ui && !v.hidden;
+  rc.ui.kiosk = v.kiosk;
   return rc;
 }
 
@@ -233,6 +235,8 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
   vo.hidden = v.hidden;
   vo.frames = v.frames;
   vo.quiet = o.quiet;
+  vo.kiosk = v.kiosk;
+  vo.render.ui.scale = profile.render.ui.scale;
   return app::run_view(profile, channels, vo);
 }
 
@@ -276,7 +280,7 @@ struct RunOptions {
   app::LiveOptions live;
   bool quiet = false;
   // rendering (gfx/): a viewer window when a display exists, screenshots on request
-  bool no_window = false, hidden = false, no_tool = false;
+  bool no_window = false, hidden = false, no_tool = false, no_ui = false;
   int screenshot_every = 0;
   std::string screenshot_prefix;  // empty: OUT/frame-
   std::string view = "iso", color = "heat", size = "1280x800";
@@ -342,6 +346,9 @@ gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profi
   rc.screenshot_every = o.screenshot_every;
   rc.screenshot_prefix = o.screenshot_prefix.empty() ? out_file(o.out, "frame-") : o.screenshot_prefix;
   rc.render.show_tools = !o.no_tool;
+  rc.ui.enabled = !o.no_ui && !o.hidden && !o.no_window;
+  rc.ui.scale = profile.render.ui.scale;
+  rc.ui.source = o.live.source;
   return rc;
 }
 
@@ -627,6 +634,8 @@ CLI::App* add_view_command(CLI::App& cli, BatchOptions& vb, ViewCliOptions& vv) 
   view->add_flag("--no-vsync", vv.no_vsync, "Do not sync buffer swaps to the display");
   view->add_flag("--ortho", vv.ortho, "Orthographic projection");
   view->add_flag("--hidden", vv.hidden, "No visible window (headless render thread; with --frames or --animate)");
+  view->add_flag("--no-ui", vv.no_ui, "Hide the operator UI (status bar, view and replay controls); the text HUD instead");
+  view->add_flag("--kiosk", vv.kiosk, "Full screen without decorations; quitting asks for a confirmation");
   view->add_option("--frames", vv.frames, "Stop after N frames");
   view->add_option("--screenshot-every", vv.screenshot_every, "Write a PNG every N frames")->check(CLI::Range(0, 1000000));
   view->add_option("--screenshot-prefix", vv.screenshot_prefix, "Screenshot file prefix (PREFIX000123.png)")
@@ -658,6 +667,7 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
       ->capture_default_str();
   run->add_flag("--no-window", ro.no_window, "Do not open the viewer even when a display exists");
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
+  run->add_flag("--no-ui", ro.no_ui, "Hide the operator UI (status bar, view controls); the text HUD instead");
   run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "
                   "headless: xvfb-run -a)")->check(CLI::Range(0, 1000000));
   run->add_option("--screenshot-prefix", ro.screenshot_prefix,

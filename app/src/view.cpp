@@ -73,6 +73,7 @@ PathStreamer::PathStreamer(const Profile& profile, const std::vector<ChannelPath
   motion::PlannedSweeps plan = motion::plan_channels(tools_, channels, limits, !has_tool_axes(channels));
   sweeps_ = std::move(plan.sweeps);
   duration_s_ = plan.machining_time_s;
+  if (opt_.control != nullptr) initial_ = std::make_unique<geom::LbrSolid>(solid_);
 }
 
 PathStreamer::~PathStreamer() { stop(); }
@@ -101,6 +102,25 @@ std::size_t PathStreamer::tools_at(std::size_t upto, std::array<gfx::ToolState, 
   return n;
 }
 
+double PathStreamer::advance(double sim_s, double dt_s, std::size_t next) {
+  gfx::ReplayControl* c = opt_.control;
+  if (c == nullptr) return sim_s + dt_s * opt_.speed;
+  if (!c->paused.load(std::memory_order_relaxed)) return sim_s + dt_s * c->speed.load(std::memory_order_relaxed);
+  // Paused: one step runs the next sweep (one controller sample) and nothing else.
+  int steps = c->steps.load(std::memory_order_relaxed);
+  while (steps > 0 && !c->steps.compare_exchange_weak(steps, steps - 1, std::memory_order_relaxed)) {
+  }
+  if (steps > 0 && next < sweeps_.size()) return std::max(sim_s, sweeps_[next].t_s);
+  return sim_s;
+}
+
+void PathStreamer::restart(std::size_t& next, geom::MoveId& last) {
+  for (int r = 0; r < solid_.regions(); ++r)
+    for (int l = 0; l < solid_.levels(); ++l) solid_.set_cell(r, l, initial_->cell(r, l).polys, 0);
+  next = 0;
+  last = 0;
+}
+
 void PathStreamer::loop() {
   using clock = std::chrono::steady_clock;
   std::vector<geom::SweepRef> batch;
@@ -108,32 +128,43 @@ void PathStreamer::loop() {
   batch_ms_.reserve(1 << 16);
   const auto start = clock::now();
   const auto tick = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(opt_.tick_s));
-  auto next = start;
+  auto next = clock::now(), prev = next;
+  double sim = 0.0;  // simulated machining time reached [s]
   std::size_t i = 0;
   gfx::LiveStats stats;
+  stats.total_s = duration_s_;
   std::array<gfx::ToolState, gfx::kMaxTools> tools{};
   std::size_t tool_count = 0;
   geom::MoveId last = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
-    const double sim = std::chrono::duration<double>(clock::now() - start).count() * opt_.speed;
+    const auto now = clock::now();
+    if (opt_.control != nullptr && opt_.control->restart.exchange(false)) {
+      restart(i, last);
+      sim = 0.0;
+      tool_count = 0;
+      done_.store(false, std::memory_order_release);
+    }
+    sim = advance(sim, std::chrono::duration<double>(now - prev).count(), i);
+    prev = now;
     batch.clear();
     for (; i < sweeps_.size() && sweeps_[i].t_s <= sim; ++i) {
       batch.push_back(sweeps_[i].ref);
       ex_.add_path_point(sweeps_[i].ref.to.tip);
       last = sweeps_[i].ref.id;
     }
+    const double speed = opt_.control != nullptr ? opt_.control->speed.load(std::memory_order_relaxed) : opt_.speed;
     if (!batch.empty()) {
       const auto t0 = clock::now();
       solid_.subtract(batch);
       batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
       batches_.fetch_add(1, std::memory_order_relaxed);
       tool_count = tools_at(i, tools);
-      const double t_cur = sweeps_[i - 1].t_s;
-      stats.lag_ms = std::max(0.0, (std::chrono::duration<double>(clock::now() - start).count() * opt_.speed - t_cur) /
-                                       opt_.speed * 1000.0);
-      stats.sample_rate_hz = opt_.speed / opt_.sample_period_s;
+      stats.lag_ms = std::max(0.0, (sim - sweeps_[i - 1].t_s) / speed * 1000.0);
+      stats.sample_rate_hz = speed / opt_.sample_period_s;
       stats.samples = i;
     }
+    stats.machining_s = std::min(sim, duration_s_);
+    stats.paused = opt_.control != nullptr && opt_.control->paused.load(std::memory_order_relaxed);
     const std::span<const gfx::ToolState> shown(tools.data(), tool_count);
     // Publish every tick: a refused publish (render side busy) loses nothing.
     (void)ex_.publish(solid_, shown, last, stats);
@@ -143,7 +174,8 @@ void PathStreamer::loop() {
         if (ex_.publish(solid_, shown, last, stats)) break;
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
       }
-      break;
+      done_.store(true, std::memory_order_release);
+      if (opt_.control == nullptr) break;  // with a control a restart may follow
     }
     next += tick;
     std::this_thread::sleep_until(next);
@@ -178,7 +210,7 @@ int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, c
   gfx::RenderThreadConfig rc = opt.render;
   if (opt.frames) rc.max_frames = opt.frames;
   const std::string title = channels.size() == 1 ? channels.front().path.source : profile.source;
-  gfx::Window win(rc.width, rc.height, !opt.hidden, "lbrsim — " + title);
+  gfx::Window win(rc.width, rc.height, !opt.hidden, "lbrsim — " + title, opt.kiosk);
   if (!opt.quiet) spdlog::info("OpenGL: {}", gfx::Window::gl_description());
 
   std::size_t segments = 0;
@@ -186,10 +218,18 @@ int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, c
   std::unique_ptr<geom::LbrSolid> solid;
   gfx::SolidExchange ex(std::max<std::size_t>(8192, segments + 2 * channels.size()));
   std::unique_ptr<PathStreamer> streamer;
+  gfx::ReplayControl replay;
+  replay.speed.store(opt.stream.speed);
+  rc.ui.source = title;
   if (opt.animate) {
     solid = std::make_unique<geom::LbrSolid>(stream_solid_spec(profile, channels));
     solid->clear_dirty();
-    streamer = std::make_unique<PathStreamer>(profile, channels, *solid, ex, opt.stream);
+    StreamOptions so = opt.stream;
+    if (rc.ui.enabled && !opt.hidden) {
+      so.control = &replay;
+      rc.ui.replay = &replay;
+    }
+    streamer = std::make_unique<PathStreamer>(profile, channels, *solid, ex, so);
     if (!opt.quiet) spdlog::info("streaming {:.1f} s of machining at {}x", streamer->duration_s(), opt.stream.speed);
   } else {
     solid = publish_batch_result(profile, channels, ex);
@@ -201,11 +241,11 @@ int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, c
   gfx::run_event_loop(win, rt, [&] {
     // Headless animated runs end a second after the stream does.
     static std::chrono::steady_clock::time_point done_at{};
-    if (!opt.hidden || !streamer || opt.frames) return true;
+    if (!opt.hidden || !streamer || opt.frames) return true;  // (hidden: no UI, no replay control)
     if (!streamer->done()) return true;
     if (done_at == std::chrono::steady_clock::time_point{}) done_at = std::chrono::steady_clock::now();
     return std::chrono::steady_clock::now() - done_at < std::chrono::seconds(1);
-  });
+  }, opt.kiosk);
   if (streamer) streamer->stop();
   rt.stop();
   const gfx::PacingReport& rep = rt.report();

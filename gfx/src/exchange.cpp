@@ -5,6 +5,13 @@
 
 namespace lbr::gfx {
 
+void set_alarm(Alarm& a, AlarmSeverity severity, const char* text) noexcept {
+  a.severity = severity;
+  std::size_t n = 0;
+  for (; text != nullptr && text[n] != '\0' && n + 1 < a.text.size(); ++n) a.text[n] = text[n];
+  a.text[n] = '\0';
+}
+
 ToolState tool_state(const geom::Tool& t, int tool_number, const geom::Pose& pose, int channel) {
   ToolState s;
   s.channel = channel;

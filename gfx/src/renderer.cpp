@@ -70,6 +70,7 @@ layout(location = 1) in vec3 a_nrm;
 layout(location = 2) in float a_attr;
 uniform mat4 u_vp;
 uniform mat4 u_model;
+uniform vec4 u_clip;  // section plane: kept where dot(u_clip, (p, 1)) >= 0 (GL_CLIP_DISTANCE0)
 out vec3 v_pos;
 out vec3 v_nrm;
 out float v_attr;
@@ -78,6 +79,7 @@ void main() {
   v_pos = w.xyz;
   v_nrm = mat3(u_model) * a_nrm;
   v_attr = a_attr;
+  gl_ClipDistance[0] = dot(u_clip, vec4(w.xyz, 1.0));
   gl_Position = u_vp * w;
 })";
 
@@ -94,6 +96,7 @@ uniform vec3 u_eye;
 uniform vec3 u_key;       // direction towards the key light (world)
 uniform vec3 u_stock_lo;
 uniform vec3 u_stock_hi;
+uniform int u_section;    // 1: a section plane is on; back faces seen through the cut are the cut face
 out vec4 o_col;
 vec3 heat(float t) {
   // dark blue -> blue -> cyan -> yellow -> red (older cuts cool, recent ones hot)
@@ -119,6 +122,13 @@ bool on_stock_face(vec3 p) {
 }
 void main() {
   if (u_mode == 4) { o_col = vec4(u_color, 1.0); return; }
+  if (u_section == 1 && !gl_FrontFacing) {
+    // The inside of the closed stock surface, seen through the section plane: the filled
+    // cut face, flat, with a diagonal hatch so that it reads as a cut.
+    float k = mod(floor((gl_FragCoord.x + gl_FragCoord.y) / 6.0), 2.0);
+    o_col = vec4(mix(vec3(0.80, 0.30, 0.22), vec3(0.70, 0.24, 0.18), k), 1.0);
+    return;
+  }
   vec3 n = normalize(v_nrm);
   vec3 V = normalize(u_eye - v_pos);
   if (dot(n, V) < 0.0) n = -n;
@@ -189,11 +199,12 @@ struct Renderer::Gl {
   };
   GLuint prog = 0;
   GLint u_vp = -1, u_model = -1, u_mode = -1, u_color = -1, u_max_attr = -1, u_eye = -1, u_key = -1, u_lo = -1,
-        u_hi = -1;
+        u_hi = -1, u_clip = -1, u_section = -1;
   std::vector<Region> regions;
   GLuint cyl_vao = 0, cyl_vbo[3] = {0, 0, 0}, cyl_ebo = 0;
   GLsizei cyl_count = 0;
   GLuint path_vao = 0, path_vbo = 0;
+  GLuint box_vao = 0, box_vbo = 0;
   GLsizei path_count = 0;
   GLuint fbo = 0, fbo_color = 0, fbo_depth = 0;
   int fbo_w = 0, fbo_h = 0;
@@ -210,6 +221,8 @@ struct Renderer::Gl {
     glDeleteVertexArrays(1, &cyl_vao);
     glDeleteBuffers(1, &path_vbo);
     glDeleteVertexArrays(1, &path_vao);
+    glDeleteBuffers(1, &box_vbo);
+    glDeleteVertexArrays(1, &box_vao);
     if (fbo) {
       glDeleteFramebuffers(1, &fbo);
       glDeleteRenderbuffers(1, &fbo_color);
@@ -311,6 +324,8 @@ Renderer::Renderer(const geom::LbrSolid& initial, const RenderOptions& opt)
   g.u_key = glGetUniformLocation(g.prog, "u_key");
   g.u_lo = glGetUniformLocation(g.prog, "u_stock_lo");
   g.u_hi = glGetUniformLocation(g.prog, "u_stock_hi");
+  g.u_clip = glGetUniformLocation(g.prog, "u_clip");
+  g.u_section = glGetUniformLocation(g.prog, "u_section");
   g.regions.resize(static_cast<std::size_t>(mirror_.regions()));
   for (Gl::Region& r : g.regions) Gl::make_vao(r.vao, r.vbo, r.ebo);
   g.make_cylinder();
@@ -382,6 +397,7 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
   glDisable(GL_CULL_FACE);
   if (opt_.show_tools) draw_tools();
   if (opt_.show_path && gl_->path_count > 1) draw_path();
+  if (opt_.show_outline) draw_outline();
   glBindVertexArray(0);
   if (opt_.show_hud) draw_hud(w, h);
   fi.draw_ms = std::chrono::duration<double, std::milli>(clock::now() - t2).count();
@@ -463,6 +479,7 @@ void Renderer::draw_stock(const Camera& cam, const glm::dmat4& vp, int w, int h,
   glFrontFace(GL_CCW);
   glUseProgram(g.prog);
   set_scene_uniforms(cam, vp);
+  set_section();
   const int mode = opt_.color == ColorMode::Plain ? 0 : (opt_.color == ColorMode::Heat ? 1 : 2);
   glUniform1i(g.u_mode, mode);
   glUniform3f(g.u_color, 0.66f, 0.68f, 0.71f);
@@ -477,6 +494,29 @@ void Renderer::draw_stock(const Camera& cam, const glm::dmat4& vp, int w, int h,
     glDrawElements(GL_TRIANGLES, gr.count, GL_UNSIGNED_INT, nullptr);
     fi.triangles += static_cast<std::uint64_t>(gr.count / 3);
   }
+  glDisable(GL_CLIP_DISTANCE0);  // tools and path are not cut
+  glUniform1i(g.u_section, 0);
+}
+
+// The section plane (RenderOptions::section_axis): clips the stock, and shows its back
+// faces (the inside seen through the cut) as the filled cut face, so culling is off.
+void Renderer::set_section() {
+  Gl& g = *gl_;
+  const int axis = opt_.section_axis;
+  if (axis < 0 || axis > 2) {
+    glUniform4f(g.u_clip, 0, 0, 0, 1);
+    glUniform1i(g.u_section, 0);
+    return;
+  }
+  // Keep the side below the plane (x <= pos), or above it when flipped.
+  const float sgn = opt_.section_flip ? 1.0f : -1.0f;
+  glm::vec4 plane(0.0f);
+  plane[axis] = sgn;
+  plane.w = -sgn * static_cast<float>(opt_.section_mm);
+  glUniform4fv(g.u_clip, 1, glm::value_ptr(plane));
+  glUniform1i(g.u_section, 1);
+  glEnable(GL_CLIP_DISTANCE0);
+  glDisable(GL_CULL_FACE);
 }
 
 // Camera, light and colour-scale uniforms shared by everything drawn this frame.
@@ -527,6 +567,42 @@ void Renderer::draw_tools() {
   }
   const glm::mat4 ident(1.0f);
   glUniformMatrix4fv(g.u_model, 1, GL_FALSE, glm::value_ptr(ident));
+}
+
+// The stock box's twelve edges (operator UI "Stock"), unlit.
+void Renderer::draw_outline() {
+  Gl& g = *gl_;
+  if (g.box_vao == 0) {
+    glGenVertexArrays(1, &g.box_vao);
+    glGenBuffers(1, &g.box_vbo);
+    glBindVertexArray(g.box_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, g.box_vbo);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  }
+  const geom::Box3 b = stock_box();
+  const float x[2] = {static_cast<float>(b.lo.x), static_cast<float>(b.hi.x)};
+  const float y[2] = {static_cast<float>(b.lo.y), static_cast<float>(b.hi.y)};
+  const float z[2] = {static_cast<float>(b.lo.z), static_cast<float>(b.hi.z)};
+  std::array<float, 72> v{};
+  std::size_t n = 0;
+  auto edge = [&](int i0, int j0, int k0, int i1, int j1, int k1) {
+    for (float c : {x[i0], y[j0], z[k0], x[i1], y[j1], z[k1]}) v[n++] = c;
+  };
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) {
+      edge(i, j, 0, i, j, 1);  // along Z
+      edge(i, 0, j, i, 1, j);  // along Y
+      edge(0, i, j, 1, i, j);  // along X
+    }
+  glBindVertexArray(g.box_vao);
+  glBindBuffer(GL_ARRAY_BUFFER, g.box_vbo);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(sizeof v), v.data(), GL_STREAM_DRAW);
+  glVertexAttrib3f(1, 0, 0, 1);
+  glVertexAttrib1f(2, 0);
+  glUniform1i(g.u_mode, 4);
+  glUniform3f(g.u_color, 0.35f, 0.75f, 1.0f);
+  glDrawArrays(GL_LINES, 0, 24);
 }
 
 void Renderer::draw_path() {

@@ -9,40 +9,68 @@ namespace {
 
 struct Input {
   RenderThread* rt = nullptr;
-  bool orbiting = false, panning = false;
+  EventRouter* router = nullptr;
+  bool kiosk = false;
   double x = 0, y = 0;
-  int h = 1;
 };
 
 Input* input_of(GLFWwindow* w) { return static_cast<Input*>(glfwGetWindowUserPointer(w)); }
 
-void on_button(GLFWwindow* w, int button, int action, int) {
-  Input* in = input_of(w);
-  const bool down = action == GLFW_PRESS;
-  if (button == GLFW_MOUSE_BUTTON_LEFT) in->orbiting = down;
-  if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE) in->panning = down;
-  glfwGetCursorPos(w, &in->x, &in->y);
+}  // namespace
+
+void EventRouter::button(int button, bool down, double x, double y) {
+  x_ = x;
+  y_ = y;
+  const int b = button == GLFW_MOUSE_BUTTON_LEFT ? 0 : (button == GLFW_MOUSE_BUTTON_RIGHT ? 1 : 2);
+  if (down && !orbiting_ && !panning_) ui_owns_ = rt_.ui_hit(x, y);
+  if (ui_owns_) {
+    rt_.ui_event({UiEvent::Kind::Button, x, y, b, down, 0});
+    if (!down) ui_owns_ = false;
+    return;
+  }
+  // One-finger (left) drag orbits, or pans when the UI's Pan switch is on; right/middle pan.
+  const bool left_pans = rt_.touch_pan();
+  if (b == 0) (left_pans ? panning_ : orbiting_) = down;
+  if (b != 0) panning_ = down;
+  if (!down) orbiting_ = panning_ = false;
 }
 
-void on_cursor(GLFWwindow* w, double x, double y) {
-  Input* in = input_of(w);
-  const double dx = x - in->x, dy = y - in->y;
-  in->x = x;
-  in->y = y;
-  if (in->orbiting) in->rt->edit([&](Camera& c, RenderOptions&) { c.orbit(dx, dy); });
-  else if (in->panning) {
-    const double h = in->h;
-    in->rt->edit([&](Camera& c, RenderOptions&) { c.pan(dx, dy, h); });
+void EventRouter::cursor(double x, double y) {
+  const double dx = x - x_, dy = y - y_;
+  x_ = x;
+  y_ = y;
+  rt_.ui_event({UiEvent::Kind::Move, x, y, 0, false, 0});
+  if (ui_owns_) return;
+  if (orbiting_) rt_.edit([&](Camera& c, RenderOptions&) { c.orbit(dx, dy); });
+  else if (panning_) {
+    const double h = h_px_;
+    rt_.edit([&](Camera& c, RenderOptions&) { c.pan(dx, dy, h); });
   }
 }
 
-void on_scroll(GLFWwindow* w, double, double dy) {
-  input_of(w)->rt->edit([&](Camera& c, RenderOptions&) { c.zoom(dy); });
+void EventRouter::scroll(double dy) {
+  if (rt_.ui_hit(x_, y_)) {
+    rt_.ui_event({UiEvent::Kind::Scroll, x_, y_, 0, false, dy});
+    return;
+  }
+  rt_.edit([&](Camera& c, RenderOptions&) { c.zoom(dy); });
 }
+
+namespace {
+
+void on_button(GLFWwindow* w, int button, int action, int) {
+  Input* in = input_of(w);
+  glfwGetCursorPos(w, &in->x, &in->y);
+  in->router->button(button, action == GLFW_PRESS, in->x, in->y);
+}
+
+void on_cursor(GLFWwindow* w, double x, double y) { input_of(w)->router->cursor(x, y); }
+
+void on_scroll(GLFWwindow* w, double, double dy) { input_of(w)->router->scroll(dy); }
 
 void on_size(GLFWwindow* w, int width, int height) {
   Input* in = input_of(w);
-  in->h = height;
+  in->router->set_height(height);
   if (width > 0 && height > 0) in->rt->resize(width, height);
 }
 
@@ -68,20 +96,30 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
     case GLFW_KEY_K: rt.edit([](Camera&, RenderOptions& o) { o.show_tools = !o.show_tools; }); break;
     case GLFW_KEY_H: rt.edit([](Camera&, RenderOptions& o) { o.show_hud = !o.show_hud; }); break;
     case GLFW_KEY_O: rt.edit([](Camera& c, RenderOptions&) { c.ortho = !c.ortho; }); break;
-    case GLFW_KEY_ESCAPE: case GLFW_KEY_Q: glfwSetWindowShouldClose(w, GLFW_TRUE); break;
+    case GLFW_KEY_ESCAPE: case GLFW_KEY_Q:
+      if (input_of(w)->kiosk) rt.ask_quit();  // kiosk: the UI asks for a confirmation
+      else glfwSetWindowShouldClose(w, GLFW_TRUE);
+      break;
     default: break;
   }
 }
 
 }  // namespace
 
-void run_event_loop(Window& win, RenderThread& rt, const std::function<bool()>& keep_going) {
+void run_event_loop(Window& win, RenderThread& rt, const std::function<bool()>& keep_going, bool kiosk) {
   GLFWwindow* w = win.handle();
-  Input in;
-  in.rt = &rt;
   int fw = 0, fh = 0;
   glfwGetFramebufferSize(w, &fw, &fh);
-  in.h = fh > 0 ? fh : 1;
+  EventRouter router(rt, fh > 0 ? fh : 1);
+  Input in;
+  in.rt = &rt;
+  in.router = &router;
+  in.kiosk = kiosk;
+  // Kiosk: the window manager's close goes through the confirmation too.
+  if (kiosk) glfwSetWindowCloseCallback(w, [](GLFWwindow* ww) {
+    glfwSetWindowShouldClose(ww, GLFW_FALSE);
+    input_of(ww)->rt->ask_quit();
+  });
   if (fw > 0 && fh > 0) rt.resize(fw, fh);  // the framebuffer may differ from the window size (HiDPI)
   glfwSetWindowUserPointer(w, &in);
   glfwSetMouseButtonCallback(w, on_button);
@@ -89,7 +127,9 @@ void run_event_loop(Window& win, RenderThread& rt, const std::function<bool()>& 
   glfwSetScrollCallback(w, on_scroll);
   glfwSetFramebufferSizeCallback(w, on_size);
   glfwSetKeyCallback(w, on_key);
-  while (!glfwWindowShouldClose(w) && rt.running() && (!keep_going || keep_going())) glfwWaitEventsTimeout(0.05);
+  while (!glfwWindowShouldClose(w) && !rt.quit_confirmed() && rt.running() && (!keep_going || keep_going()))
+    glfwWaitEventsTimeout(0.05);
+  glfwSetWindowCloseCallback(w, nullptr);
   glfwSetWindowUserPointer(w, nullptr);
   glfwSetMouseButtonCallback(w, nullptr);
   glfwSetCursorPosCallback(w, nullptr);

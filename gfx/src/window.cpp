@@ -40,7 +40,7 @@ void set_display_lost_handler(DisplayLostHandler handler) noexcept {
   XSetIOErrorHandler(handler != nullptr ? on_x_io_error : nullptr);
 }
 
-Window::Window(int width, int height, bool visible, const std::string& title) : visible_(visible) {
+Window::Window(int width, int height, bool visible, const std::string& title, bool fullscreen) : visible_(visible) {
   if (!display_available())
     throw DisplayError(
         "no display: DISPLAY and WAYLAND_DISPLAY are not set, so no OpenGL window can be opened. "
@@ -59,7 +59,16 @@ Window::Window(int width, int height, bool visible, const std::string& title) : 
   // 4x multisampling on visible windows with a hardware renderer; a software rasteriser
   // (llvmpipe) pays for every sample, so the window is recreated without it there.
   glfwWindowHint(GLFW_SAMPLES, visible ? 4 : 0);
-  w_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  GLFWmonitor* monitor = nullptr;
+  if (fullscreen && visible) {
+    glfwWindowHint(GLFW_DECORATED, GLFW_FALSE);
+    monitor = glfwGetPrimaryMonitor();
+    if (const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr) {
+      width = mode->width;
+      height = mode->height;
+    }
+  }
+  w_ = glfwCreateWindow(width, height, title.c_str(), monitor, nullptr);
   if (w_ && visible) {
     glfwMakeContextCurrent(w_);
     const auto* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
@@ -68,7 +77,7 @@ Window::Window(int width, int height, bool visible, const std::string& title) : 
       glfwMakeContextCurrent(nullptr);
       glfwDestroyWindow(w_);
       glfwWindowHint(GLFW_SAMPLES, 0);
-      w_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+      w_ = glfwCreateWindow(width, height, title.c_str(), monitor, nullptr);
     }
   }
   if (!w_) {

@@ -29,6 +29,10 @@ struct StreamOptions {
   double speed = 1.0;             // simulated seconds per wall second
   double sample_period_s = 0.004; // controller sample period the path is sampled at [s]
   double tick_s = 0.010;          // geometry batch period (wall) [s]
+  // Operator replay control (pause / step / speed / restart), or nullptr: stream at `speed`
+  // to the end. With a control the streamer keeps running after the end (a restart may
+  // come) until stop().
+  gfx::ReplayControl* control = nullptr;
 };
 
 // Streams the channels' tool paths through `solid` on a geometry thread: each tick, the
@@ -58,6 +62,10 @@ class PathStreamer {
 
  private:
   void loop();
+  // Simulated time [s] reached after `dt_s` of wall time (speed, pause, single steps).
+  double advance(double sim_s, double dt_s, std::size_t next);
+  // Back to the untouched stock; every cell is republished.
+  void restart(std::size_t& next, geom::MoveId& last);
   // Tools to draw: each channel's milling tool at the end of its latest sweep up to `upto`.
   std::size_t tools_at(std::size_t upto, std::array<gfx::ToolState, gfx::kMaxTools>& out) const;
 
@@ -65,6 +73,7 @@ class PathStreamer {
   std::vector<motion::TimedSweep> sweeps_;
   double duration_s_ = 0.0;
   geom::LbrSolid& solid_;
+  std::unique_ptr<geom::LbrSolid> initial_;  // the untouched stock (restart), with a control only
   gfx::SolidExchange& ex_;
   StreamOptions opt_;
   std::thread thread_;
@@ -83,6 +92,7 @@ struct ViewOptions {
   bool hidden = false;         // no visible window (headless run of the render thread)
   std::size_t frames = 0;      // stop after N frames (0: until the window closes / the stream ends)
   bool quiet = false;
+  bool kiosk = false;          // full screen, undecorated, quit needs the UI's confirmation
 };
 
 // `lbrsim view`: the render thread on a window, fed by a batch result or a streamed run of

@@ -40,6 +40,19 @@ struct ToolState {
 };
 [[nodiscard]] ToolState tool_state(const geom::Tool& t, int tool_number, const geom::Pose& pose, int channel = 0);
 
+// An alarm for the operator's status bar (e.g. a collision the geometry side found). Plain
+// fixed-size storage: the geometry thread fills it without allocating; the text is
+// NUL-terminated and cut at kAlarmTextChars - 1 characters.
+enum class AlarmSeverity : std::uint8_t { Info, Warning, Error };
+inline constexpr std::size_t kAlarmTextChars = 96;
+inline constexpr int kMaxAlarms = 8;
+struct Alarm {
+  AlarmSeverity severity = AlarmSeverity::Info;
+  std::array<char, kAlarmTextChars> text{};
+};
+// Copies `text` into `a` (cut to fit, NUL-terminated). Real-time safe, no allocation.
+void set_alarm(Alarm& a, AlarmSeverity severity, const char* text) noexcept;
+
 // Counters of the live pipeline shown in the HUD (all plain values, copied per snapshot).
 struct LiveStats {
   double lag_ms = 0;             // now − receive time of the newest applied sample
@@ -51,6 +64,14 @@ struct LiveStats {
   std::uint64_t samples_held = 0;       // waiting on the HAL side for room in the ring
   bool realtime = false;         // SCHED_FIFO granted to the HAL/geometry threads
   bool live = false;             // false: batch result or replay without live counters
+  // Replay / program position for the status bar (negative: unknown).
+  double machining_s = -1;       // simulated machining time reached [s]
+  double total_s = -1;           // machining time of the whole program [s]
+  std::int64_t program_line = -1;  // source line of the move being cut (1-based)
+  bool paused = false;           // a replay paused by the operator
+  // Alarms shown in red/amber in the status bar; the first `alarm_count` entries.
+  std::array<Alarm, kMaxAlarms> alarms{};
+  int alarm_count = 0;
 };
 
 struct CellUpdate {

@@ -11,6 +11,8 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -21,9 +23,15 @@
 #include "gfx/camera.hpp"
 #include "gfx/exchange.hpp"
 #include "gfx/renderer.hpp"
+#include "gfx/ui.hpp"
 #include "gfx/window.hpp"
 
 namespace lbr::gfx {
+
+namespace detail {
+class Ui;
+struct UiActions;
+}  // namespace detail
 
 struct RenderThreadConfig {
   double rate_hz = 30.0;
@@ -35,6 +43,7 @@ struct RenderThreadConfig {
   int screenshot_every = 0;          // 0: none; N: a PNG every N frames
   std::string screenshot_prefix = "frame-";  // files PREFIX000123.png
   std::size_t max_frames = 0;        // 0: until stop(); otherwise stop by itself after N frames
+  UiConfig ui;                       // the operator UI (visible windows only; replaces the HUD)
 };
 
 // Frame-pacing record of a run (benchmark output, docs/performance.md).
@@ -73,12 +82,34 @@ class RenderThread {
 
   // Frame loop passes so far (any thread): the service watchdog's heartbeat (app/watchdog.hpp).
   [[nodiscard]] std::uint64_t frames_done() const noexcept { return frames_done_.load(std::memory_order_relaxed); }
+  // --- operator UI (main thread; no-ops without it) ---
+  // Queues a pointer event for the UI (applied at the next frame).
+  void ui_event(const UiEvent& e);
+  // True when (x, y) [window px] lies on the UI as drawn last frame, or a modal dialog is
+  // open: a press there belongs to the UI, not to the 3D view.
+  [[nodiscard]] bool ui_hit(double x, double y);
+  [[nodiscard]] bool ui_enabled() const noexcept { return ui_on_; }
+  void ask_quit();  // kiosk: show the quit confirmation
+  [[nodiscard]] bool quit_confirmed() const noexcept { return quit_.load(std::memory_order_acquire); }
+  // One-finger drag pans instead of orbiting (the UI's Orbit / Pan switch).
+  [[nodiscard]] bool touch_pan() const noexcept { return touch_pan_.load(std::memory_order_relaxed); }
+  // The next shown frame as drawn, UI included (visible windows); waits up to timeout_s and
+  // returns an empty image when no frame came.
+  [[nodiscard]] Image capture(double timeout_s);
+  // Where the UI drew the control `label` ("Top", "Pause", "##section", ...) last frame;
+  // false when it was not drawn.
+  [[nodiscard]] bool ui_item(const std::string& label, UiRect& out);
 
   // Available after stop().
   [[nodiscard]] const PacingReport& report() const noexcept { return report_; }
 
  private:
   void loop();
+  // Steps of one frame of loop().
+  void sync(Renderer& ren, Camera& cam, int& w, int& h);
+  void apply_ui(const detail::UiActions& act);
+  FrameInfo draw(Renderer& ren, const Camera& cam, int w, int h, double dt_s);
+  void serve_capture(int w, int h);
 
   Window& win_;
   SolidExchange& ex_;
@@ -93,6 +124,16 @@ class RenderThread {
   int w_ = 0, h_ = 0;
   bool fit_ = true;
   PacingReport report_;
+  // Operator UI state shared with the main thread (under mu_ unless atomic).
+  bool ui_on_ = false;
+  detail::Ui* ui_ = nullptr;         // render thread only, alive inside loop()
+  std::deque<UiEvent> events_;
+  std::vector<UiRect> ui_rects_;
+  std::vector<std::pair<std::string, UiRect>> ui_items_;
+  bool ui_modal_ = false, ask_quit_ = false, capture_req_ = false, capture_done_ = false;
+  Image capture_;
+  std::condition_variable capture_cv_;
+  std::atomic<bool> quit_{false}, touch_pan_{false};
 };
 
 }  // namespace lbr::gfx

@@ -26,6 +26,12 @@ struct RenderOptions {
   bool show_tools = true;
   bool show_path = true;
   bool show_hud = true;
+  bool show_outline = false;  // the stock box's edges
+  // Section plane (operator UI): -1 off, 0/1/2 a plane normal to X/Y/Z at section_mm
+  // (workpiece frame); the part on the low side is kept (the high side when flipped).
+  int section_axis = -1;
+  double section_mm = 0;
+  bool section_flip = false;
   std::string notice;  // a warning line on the HUD (e.g. input that does not match the profile)
   mesh::MeshOptions mesh;
   int max_regions_per_frame = 16;   // upper bound of the adaptive per-frame rebuild limit
@@ -88,6 +94,13 @@ class Renderer {
   Image render_offscreen(const Camera& cam, int w, int h, bool with_depth = false, FrameInfo* info = nullptr);
 
   [[nodiscard]] RenderOptions& options() noexcept { return opt_; }
+  // What the HUD shows: the newest snapshot's counters, tools, the last frame's figures.
+  [[nodiscard]] const LiveStats& live() const noexcept { return live_; }
+  [[nodiscard]] std::span<const ToolState> tools() const noexcept {
+    return {tools_.data(), static_cast<std::size_t>(tool_count_)};
+  }
+  [[nodiscard]] const FrameInfo& last_frame() const noexcept { return last_; }
+  [[nodiscard]] const PacingInfo& pacing() const noexcept { return pacing_; }
   [[nodiscard]] const MeshMirror& mirror() const noexcept { return mirror_; }
   [[nodiscard]] geom::Box3 stock_box() const noexcept;
   // Number of times region r's buffers were uploaded (tests: what a frame touched).
@@ -102,8 +115,10 @@ class Renderer {
   void upload_path();
   void draw_stock(const Camera& cam, const glm::dmat4& vp, int w, int h, FrameInfo& fi);
   void set_scene_uniforms(const Camera& cam, const glm::dmat4& vp);
+  void set_section();
   void draw_tools();
   void draw_path();
+  void draw_outline();
   void draw_hud(int w, int h);
 
   RenderOptions opt_;

@@ -33,7 +33,8 @@ class Window {
   // Throws DisplayError (with a hint to use xvfb-run) when no display is available, and
   // std::runtime_error with GLFW's message when the context cannot be created. The context
   // is current on the calling thread afterwards.
-  Window(int width, int height, bool visible, const std::string& title = "lbrsim");
+  // `fullscreen` (kiosk): undecorated, covering the primary monitor at its current mode.
+  Window(int width, int height, bool visible, const std::string& title = "lbrsim", bool fullscreen = false);
   ~Window();
   Window(const Window&) = delete;
   Window& operator=(const Window&) = delete;

@@ -1,0 +1,334 @@
+// The operator UI (docs/ui.md) on a real window under `xvfb-run -a`: pointer events are
+// injected at the GLFW level (gfx::EventRouter, what the GLFW callbacks call) at the places
+// where the UI drew its controls, and the assertions read the frame the window shows
+// (RenderThread::capture) or the state the control drives. A view button changes the camera
+// and the image as expected; the section slider removes the part beyond the plane exactly
+// where the plane projects; pause stops the removed volume from growing.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <thread>
+
+#include <glm/glm.hpp>
+
+#include "app/outputs.hpp"
+#include "app/profile.hpp"
+#include "app/view.hpp"
+#include "gfx/render_thread.hpp"
+#include "gfx/renderer.hpp"
+#include "gfx/viewer.hpp"
+#include "gfx/window.hpp"
+#include "gfx_test_util.hpp"
+
+namespace lbr {
+namespace {
+
+using namespace test;
+using namespace test::gfx_scene;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kW = 1024, kH = 768;
+
+bool wait_for(const std::function<bool()>& cond, double timeout_s = 30.0) {
+  const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (Clock::now() < end) {
+    if (cond()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return cond();
+}
+
+bool is_background(const std::uint8_t* p) {  // the clear colour (0.13, 0.14, 0.17)
+  return std::abs(p[0] - 33) <= 2 && std::abs(p[1] - 36) <= 2 && std::abs(p[2] - 43) <= 2;
+}
+
+// A window with the render thread and the UI on, and the router the GLFW callbacks use.
+class UiWindow {
+ public:
+  UiWindow(const geom::LbrSolid& solid, gfx::StandardView view, gfx::ReplayControl* replay = nullptr, int width = kW,
+           int height = kH, bool kiosk = false) {
+    win_ = std::make_unique<gfx::Window>(width, height, true, "gfx_ui_test");
+    gfx::RenderThreadConfig cfg;
+    cfg.rate_hz = 20;
+    cfg.vsync = false;
+    cfg.width = width;
+    cfg.height = height;
+    cfg.view = view;
+    cfg.ortho = view == gfx::StandardView::Top;
+    cfg.render.show_tools = cfg.render.show_path = false;
+    cfg.ui.enabled = true;
+    cfg.ui.scale = 1.5f;
+    cfg.ui.source = "gfx_ui_test";
+    cfg.ui.replay = replay;
+    cfg.ui.kiosk = kiosk;
+    rt_ = std::make_unique<gfx::RenderThread>(*win_, ex_, solid, cfg);
+    router_ = std::make_unique<gfx::EventRouter>(*rt_, height);
+    rt_->start();
+  }
+  ~UiWindow() { rt_->stop(); }
+
+  gfx::SolidExchange& exchange() { return ex_; }
+  gfx::RenderThread& rt() { return *rt_; }
+  // Where `label` is drawn, once it stays in place from one frame to the next (windows that
+  // just appeared, like a dialog, are measured in their first frames).
+  gfx::UiRect item(const std::string& label) {
+    gfx::UiRect r, again;
+    EXPECT_TRUE(wait_for([&] {
+      if (!rt_->ui_item(label, r)) return false;
+      (void)rt_->capture(10.0);
+      return rt_->ui_item(label, again) && again.x0 == r.x0 && again.y0 == r.y0 && again.x1 == r.x1 &&
+             again.y1 == r.y1;
+    })) << "the UI never drew '" << label << "' in one place";
+    return r;
+  }
+  // A one-finger tap at (x, y).
+  void tap(double x, double y) {
+    router_->cursor(x, y);
+    router_->button(0, true, x, y);
+    router_->button(0, false, x, y);
+  }
+  void tap(const std::string& label) {
+    const gfx::UiRect r = item(label);
+    tap(0.5 * (r.x0 + r.x1), 0.5 * (r.y0 + r.y1));
+  }
+  void drag(double x0, double y0, double x1, double y1) {
+    router_->cursor(x0, y0);
+    router_->button(0, true, x0, y0);
+    for (int i = 1; i <= 10; ++i) router_->cursor(x0 + (x1 - x0) * i / 10.0, y0 + (y1 - y0) * i / 10.0);
+    router_->button(0, false, x1, y1);
+  }
+  std::pair<gfx::Camera, gfx::RenderOptions> state() {
+    std::pair<gfx::Camera, gfx::RenderOptions> s;
+    rt_->edit([&](gfx::Camera& c, gfx::RenderOptions& o) { s = {c, o}; });
+    return s;
+  }
+  // A frame drawn after everything asked so far (two frames later), as the window shows it.
+  gfx::Image frame() {
+    (void)rt_->capture(30.0);
+    gfx::Image img = rt_->capture(30.0);
+    EXPECT_GT(img.width, 0);
+    return img;
+  }
+
+ private:
+  gfx::SolidExchange ex_;
+  std::unique_ptr<gfx::Window> win_;
+  std::unique_ptr<gfx::RenderThread> rt_;
+  std::unique_ptr<gfx::EventRouter> router_;
+};
+
+class GfxUi : public ::testing::Test {
+ protected:
+  // A hidden window for the whole suite keeps GLFW's one X connection open between the
+  // tests' windows (no reconnect to a display that other xvfb-run instances may be racing for).
+  static void SetUpTestSuite() {
+    if (gfx::display_available()) keep_ = std::make_unique<gfx::Window>(16, 16, false, "gfx_ui_test");
+  }
+  static void TearDownTestSuite() { keep_.reset(); }
+  void SetUp() override {
+    if (!keep_) GTEST_SKIP() << "no display (run under xvfb-run -a)";
+  }
+  static std::unique_ptr<gfx::Window> keep_;
+};
+std::unique_ptr<gfx::Window> GfxUi::keep_;
+
+geom::LbrSolid pocketed() {
+  geom::LbrSolid s = stock();
+  const geom::CutterShape t6 = flat6();
+  const auto path = pocket_path();
+  for (std::size_t i = 1; i < path.size(); ++i)
+    cut(s, t6, {path[i - 1], {0, 0, 1}}, {path[i], {0, 0, 1}}, static_cast<geom::MoveId>(i));
+  s.clear_dirty();
+  return s;
+}
+
+const std::uint8_t* pixel_at(const gfx::Image& img, const gfx::Camera& cam, glm::dvec3 p) {
+  const glm::dvec2 q = cam.project(p, img.width, img.height);
+  return img.px(static_cast<int>(q.x), static_cast<int>(q.y));
+}
+
+TEST_F(GfxUi, TopButtonShowsTheStockFromAboveFilledToItsEdges) {
+  UiWindow w(pocketed(), gfx::StandardView::Iso);
+  const double yaw0 = w.state().first.yaw;
+  w.tap("Top");
+  ASSERT_TRUE(wait_for([&] { return std::abs(w.state().first.pitch - glm::radians(90.0)) < 1e-6; }));
+  const gfx::Image img = w.frame();
+  const gfx::Camera cam = w.state().first;
+  EXPECT_TRUE(cam.ortho);
+  // The stock's outline projects to an axis-aligned rectangle: 0.5 mm inside its left and
+  // back edges is material, 0.5 mm outside is background (22 px/mm at this size).
+  for (const glm::dvec3& inside : {glm::dvec3{0.5, 15, 0}, glm::dvec3{20, 29.5, 0}, glm::dvec3{2, 10, 0}}) {
+    EXPECT_FALSE(w.rt().ui_hit(cam.project(inside, kW, kH).x, cam.project(inside, kW, kH).y));
+    EXPECT_FALSE(is_background(pixel_at(img, cam, inside))) << inside.x << "," << inside.y;
+  }
+  for (const glm::dvec3& outside : {glm::dvec3{-0.5, 15, 0}, glm::dvec3{20, 30.5, 0}})
+    EXPECT_TRUE(is_background(pixel_at(img, cam, outside))) << outside.x << "," << outside.y;
+  // A drag on the 3D view orbits; a drag that starts on the UI panel does not.
+  const gfx::UiRect fit = w.item("Fit");
+  w.drag(0.5 * (fit.x0 + fit.x1), 0.5 * (fit.y0 + fit.y1), 0.5 * (fit.x0 + fit.x1) - 200, 300);
+  EXPECT_DOUBLE_EQ(w.state().first.yaw, cam.yaw);
+  w.drag(300, 300, 400, 300);
+  EXPECT_NE(w.state().first.yaw, cam.yaw);
+  EXPECT_NE(yaw0, glm::radians(90.0));
+}
+
+TEST_F(GfxUi, SectionSliderCutsAwayThePartBeyondThePlane) {
+  UiWindow w(pocketed(), gfx::StandardView::Top);
+  w.tap("X");
+  ASSERT_TRUE(wait_for([&] { return w.state().second.section_axis == 0; }));
+  EXPECT_DOUBLE_EQ(w.state().second.section_mm, 20.0);  // the stock's middle
+  gfx::Image img = w.frame();
+  const gfx::Camera cam = w.state().first;
+  // Points of the top face along y = 25 mm, clear of the UI's panels.
+  auto at = [&](const gfx::Image& im, double x_mm) {
+    const glm::dvec2 q = cam.project({x_mm, 25, 0}, kW, kH);
+    EXPECT_FALSE(w.rt().ui_hit(q.x, q.y)) << "x = " << x_mm << " mm lies under the UI";
+    return im.px(static_cast<int>(q.x), static_cast<int>(q.y));
+  };
+  EXPECT_FALSE(is_background(at(img, 5)));
+  EXPECT_FALSE(is_background(at(img, 19)));
+  EXPECT_TRUE(is_background(at(img, 21)));
+  EXPECT_TRUE(is_background(at(img, 30)));
+  // Touch the slider at 60 % of its track: the plane moves to about x = 24.
+  const gfx::UiRect s = w.item("##section");
+  w.tap(s.x0 + 0.6 * (s.x1 - s.x0), 0.5 * (s.y0 + s.y1));
+  ASSERT_TRUE(wait_for([&] { return w.state().second.section_mm > 21.0; }));
+  const double x_mm = w.state().second.section_mm;
+  EXPECT_NEAR(x_mm, 24.0, 2.5);
+  img = w.frame();
+  EXPECT_FALSE(is_background(at(img, x_mm - 1)));
+  EXPECT_TRUE(is_background(at(img, x_mm + 1)));
+  EXPECT_TRUE(is_background(at(img, 30)));
+  // Off: the whole stock again.
+  w.tap("Off");
+  ASSERT_TRUE(wait_for([&] { return w.state().second.section_axis == -1; }));
+  img = w.frame();
+  EXPECT_FALSE(is_background(at(img, 30)));
+}
+
+TEST_F(GfxUi, PauseStopsTheRemovedVolumeFromGrowing) {
+  const app::Profile profile = app::default_profile();
+  const std::vector<app::ChannelPath> channels{{"", app::demo_toolpath(), profile.kin}};
+  geom::LbrSolid solid(app::stream_solid_spec(profile, channels));
+  solid.clear_dirty();
+  gfx::ReplayControl ctl;
+  UiWindow w(solid, gfx::StandardView::Iso, &ctl);
+  app::StreamOptions so;
+  so.control = &ctl;
+  app::PathStreamer streamer(profile, channels, solid, w.exchange(), so);
+  ctl.speed.store(streamer.duration_s() / 30.0);  // the whole program in about 30 s
+  streamer.start();
+  ASSERT_TRUE(wait_for([&] { return solid.volume_mm3() < solid.initial_volume_mm3() - 1.0; }));
+  w.tap("Pause");
+  ASSERT_TRUE(wait_for([&] { return ctl.paused.load(); }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the tick in flight ends
+  const std::uint64_t b0 = streamer.batches();
+  const double v0 = solid.volume_mm3();  // no subtract() runs while paused
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  EXPECT_EQ(streamer.batches(), b0);
+  EXPECT_EQ(solid.volume_mm3(), v0);
+  gfx::UiRect play;
+  EXPECT_TRUE(wait_for([&] { return w.rt().ui_item("Play", play); }));  // the button now says Play
+  // One step: exactly one more batch (one controller sample).
+  w.tap("Step");
+  ASSERT_TRUE(wait_for([&] { return streamer.batches() == b0 + 1; }, 10.0));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(streamer.batches(), b0 + 1);
+  w.tap("Play");
+  ASSERT_TRUE(wait_for([&] { return !ctl.paused.load() && streamer.batches() > b0 + 5; }));
+  ctl.speed.store(streamer.duration_s());  // the rest in about a second
+  ASSERT_TRUE(wait_for([&] { return streamer.done(); }, 60.0));
+  EXPECT_LT(solid.volume_mm3(), v0 - 1.0);  // the streamer idles at the end: no subtract() runs
+  // Paused, Restart brings back the untouched stock (and nothing is cut again while paused).
+  w.tap("Pause");
+  ASSERT_TRUE(wait_for([&] { return ctl.paused.load(); }));
+  w.tap("Restart");
+  ASSERT_TRUE(wait_for([&] { return !streamer.done(); }));  // cleared once the stock is back
+  EXPECT_NEAR(solid.volume_mm3(), solid.initial_volume_mm3(), 1e-6 * solid.initial_volume_mm3());
+  streamer.stop();
+}
+
+// Live counters with alarms, as the geometry side would publish them.
+gfx::LiveStats live_stats(bool alarm) {
+  gfx::LiveStats L;
+  L.live = true;
+  L.sample_rate_hz = 250;
+  L.lag_ms = 6.5;
+  L.samples = 12000;
+  L.ring_capacity = 4096;
+  L.ring_high_water = 300;
+  L.machining_s = 41.2;
+  L.total_s = 96.0;
+  L.program_line = 118;
+  if (alarm) {
+    gfx::set_alarm(L.alarms[0], gfx::AlarmSeverity::Error, "holder collides with the stock at X12.0 Y9.0 Z-3.0");
+    gfx::set_alarm(L.alarms[1], gfx::AlarmSeverity::Warning, "rapid into material (line 117)");
+    L.alarm_count = 2;
+  }
+  return L;
+}
+
+void publish(gfx::SolidExchange& ex, geom::LbrSolid& s, const gfx::LiveStats& L) {
+  const gfx::ToolState tool{0, 3, {{20, 15, -3}, {0, 0, 1}}, 3, 20, 40, 10, 20};
+  ASSERT_TRUE(wait_for([&] { return ex.publish(s, std::span(&tool, 1), 50, L); }));
+}
+
+TEST_F(GfxUi, AnErrorAlarmTurnsTheStatusBarRed) {
+  geom::LbrSolid s = pocketed();
+  UiWindow w(s, gfx::StandardView::Iso);
+  publish(w.exchange(), s, live_stats(false));
+  (void)w.item("Top");
+  const gfx::Image calm = w.frame();
+  const std::uint8_t* c = calm.px(kW - 4, kH - 4);  // the status bar's corner: its background
+  EXPECT_LT(c[0], 80);
+  publish(w.exchange(), s, live_stats(true));
+  gfx::Image red;
+  ASSERT_TRUE(wait_for([&] {
+    red = w.frame();
+    return red.px(kW - 4, kH - 4)[0] > 110;
+  }));
+  const std::uint8_t* r = red.px(kW - 4, kH - 4);
+  EXPECT_GT(r[0], 110);
+  EXPECT_LT(r[1], 40);
+  EXPECT_LT(r[2], 40);
+  EXPECT_EQ(red.px(kW / 3, kH / 3)[0], calm.px(kW / 3, kH / 3)[0]);  // the 3D view is unchanged
+}
+
+TEST_F(GfxUi, KioskQuitNeedsTheConfirmation) {
+  UiWindow w(pocketed(), gfx::StandardView::Iso, nullptr, kW, kH, true);
+  (void)w.item("Quit...");
+  w.rt().ask_quit();  // Esc / Q / the window manager's close in kiosk mode
+  w.tap("Cancel");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_FALSE(w.rt().quit_confirmed());
+  EXPECT_FALSE(w.rt().ui_hit(300, 300));  // the dialog is gone: the 3D view takes presses again
+  w.tap("Quit...");
+  w.tap("Quit");
+  EXPECT_TRUE(wait_for([&] { return w.rt().quit_confirmed(); }));
+}
+
+// Not a check: with LBR_UI_SCREENSHOTS=DIR set, writes the pictures in docs/ui.md at the two
+// panel sizes (1024x768, 1280x800).
+TEST_F(GfxUi, Screenshots) {
+  const char* dir = std::getenv("LBR_UI_SCREENSHOTS");
+  if (dir == nullptr) GTEST_SKIP() << "set LBR_UI_SCREENSHOTS=DIR to write the docs' screenshots";
+  geom::LbrSolid s = pocketed();
+  gfx::ReplayControl ctl;
+  for (auto [wpx, hpx] : {std::pair{1024, 768}, std::pair{1280, 800}}) {
+    UiWindow w(s, gfx::StandardView::Iso, &ctl, wpx, hpx);
+    publish(w.exchange(), s, live_stats(true));
+    w.tap("Heat");
+    w.tap("X");
+    (void)w.item("##section");
+    w.tap("Stock");
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    gfx::write_png(std::string(dir) + "/ui-" + std::to_string(wpx) + "x" + std::to_string(hpx) + ".png", w.frame());
+  }
+}
+
+}  // namespace
+}  // namespace lbr
