@@ -3,6 +3,7 @@
 #include "geom/parallel_subtractor.hpp"
 #include "motion/path_sweeps.hpp"
 #include "motion/tool_table.hpp"
+#include "verify/collision.hpp"
 
 #include <sys/resource.h>
 
@@ -19,8 +20,11 @@ double distance(const nc::AxisVector& a, const nc::AxisVector& b) {
   return std::hypot(b[nc::X] - a[nc::X], b[nc::Y] - a[nc::Y], b[nc::Z] - a[nc::Z]);
 }
 
-// Subtracts the moves in order, profile.batch_moves at a time.
-void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& moves, BatchResult& r, const Progress& progress) {
+// Subtracts the moves in order, profile.batch_moves at a time. With a `checker`, each batch
+// is checked against the stock before it is subtracted and ends early where a move meets
+// material (verify/collision.hpp), so every event sees the stock of its moment.
+void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& moves, BatchResult& r, const Progress& progress,
+               verify::CollisionChecker* checker = nullptr) {
   geom::ParallelSubtractor pool(profile.threads);
   r.threads = pool.threads();
   const auto t0 = std::chrono::steady_clock::now();
@@ -55,7 +59,7 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   };
   std::size_t done_moves = 0;
   const geom::ParallelSubtractor::BatchDone done = [&](const geom::SubtractStats&) {
-    done_moves = std::min(done_moves + per, moves.size());
+    done_moves = checker != nullptr ? begin : std::min(done_moves + per, moves.size());
     if (!progress) return;
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(1)) {
@@ -63,7 +67,20 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
       progress(static_cast<double>(done_moves) / static_cast<double>(moves.size()));
     }
   };
-  r.stats += pool.run(r.solid, source, done);
+  if (checker == nullptr) {
+    r.stats += pool.run(r.solid, source, done);
+  } else {
+    // One batch at a time: the checks read the stock between batches.
+    std::vector<geom::SweepRef> batch;
+    while (begin < moves.size()) {
+      const std::size_t end = checker->check(r.solid, moves, begin, std::min(begin + per, moves.size()), r.events);
+      fill(begin, end, batch);
+      begin = end;
+      const geom::SubtractStats s = pool.subtract(r.solid, batch);
+      r.stats += s;
+      done(s);
+    }
+  }
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.removed_volume_mm3 = r.stock_volume_mm3 - r.solid.volume_mm3();
   if (progress) progress(1.0);
@@ -115,12 +132,15 @@ geom::SolidSpec batch_solid_spec(const Profile& profile, const motion::ToolTable
 BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress) {
   motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   tools.require_path(path);
-  BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1};
+  BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1, {}};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
   r.machining_time_s = machining_time_s(profile, path);
   std::vector<motion::TimedSweep> moves;
   motion::path_sweeps(tools, profile.kin, path, nullptr, 0, 0, moves, r.moves);
-  run_moves(profile, moves, r, progress);
+  verify::MoveIndex index;
+  index.add(path, 0);
+  verify::CollisionChecker checker(profile.checks, tools, index);
+  run_moves(profile, moves, r, progress, profile.checks.enabled ? &checker : nullptr);
   return r;
 }
 
@@ -128,12 +148,19 @@ BatchResult run_batch_channels(const Profile& profile, const std::vector<Channel
                                const Progress& progress) {
   motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   for (const ChannelPath& c : channels) tools.require_path(c.path);
-  BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1};
+  BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1, {}};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
   motion::PlannedSweeps plan = motion::plan_channels(tools, channels, emulator_limits(profile), sampled);
   r.machining_time_s = plan.machining_time_s;
   r.moves = plan.moves;
-  run_moves(profile, plan.sweeps, r, progress);
+  verify::MoveIndex index;  // segment ids of each channel (sampled: sample ids, no lines)
+  geom::MoveId base = 0;
+  for (const ChannelPath& c : channels) {
+    if (!sampled) index.add(c.path, base);
+    base += static_cast<geom::MoveId>(c.path.segments.size());
+  }
+  verify::CollisionChecker checker(profile.checks, tools, index);
+  run_moves(profile, plan.sweeps, r, progress, profile.checks.enabled ? &checker : nullptr);
   return r;
 }
 

@@ -49,6 +49,8 @@ struct BatchOptions {
   bool view_window = false;
   bool show_tool = false;  // batch --png: a finished-part picture has no tool unless asked for
   bool no_tool = false;    // view: hide the tool
+  std::string fail_on = "never";  // exit 3 when the checks raise events of this severity or worse
+  bool no_checks = false;
 };
 
 struct ViewCliOptions {
@@ -150,13 +152,34 @@ void write_png_if_asked(const geom::LbrSolid& solid, const BatchOptions& o, cons
               o.color.c_str());
 }
 
+// Exit status of `batch --fail-on`: events at or above the chosen severity (docs/verification.md).
+constexpr int kExitEvents = 3;
+// Events printed one per line; the rest are in events.csv.
+constexpr std::size_t kEventsShown = 20;
+
+// The checks' summary line and the first events; returns kExitEvents when --fail-on says so.
+int report_events(const app::BatchResult& r, const BatchOptions& o) {
+  const verify::EventCounts c = verify::count(r.events);
+  std::printf("checks: %zu error%s, %zu warning%s (%s)\n", c.errors, c.errors == 1 ? "" : "s", c.warnings,
+              c.warnings == 1 ? "" : "s", out_file(o.out, "events.csv").c_str());
+  for (std::size_t k = 0; k < std::min(kEventsShown, r.events.size()); ++k) {
+    const verify::Event& e = r.events[k];
+    if (e.severity() == verify::Severity::Error) spdlog::error("{}", verify::describe(e));
+    else spdlog::warn("{}", verify::describe(e));
+  }
+  if (r.events.size() > kEventsShown) spdlog::warn("{} more events in {}", r.events.size() - kEventsShown, out_file(o.out, "events.csv"));
+  const bool fail = (o.fail_on == "error" && c.errors > 0) || (o.fail_on == "warning" && c.errors + c.warnings > 0);
+  return fail ? kExitEvents : 0;
+}
+
 void print_result(const app::BatchResult& r, const BatchOptions& o) {
   std::printf("removed %.3f mm3 of %.3f mm3 | machining %.2f s | simulated in %.3f s (factor %.5f) | "
               "%d levels x %d regions (%dx%d), %zu vertices\n",
               r.removed_volume_mm3, r.stock_volume_mm3, r.machining_time_s, r.wall_time_s,
               r.machining_time_s > 0 ? r.wall_time_s / r.machining_time_s : 0.0, r.solid.levels(), r.solid.regions(),
               r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
-  std::printf("wrote %s and %s\n", out_file(o.out, "metrics.json").c_str(), out_file(o.out, "levels.lbrs").c_str());
+  std::printf("wrote %s, %s and %s\n", out_file(o.out, "metrics.json").c_str(), out_file(o.out, "levels.lbrs").c_str(),
+              out_file(o.out, "events.csv").c_str());
   app::write_mesh_files(r.solid, o.stl, o.ply);
   if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
   if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
@@ -180,8 +203,9 @@ int run_channels_command(const BatchOptions& o, const app::Profile& profile, con
   app::write_batch_outputs(o.out, r, profile, names);
   std::printf("%zu channels (%s)%s\n", channels.size(), names.c_str(), o.sampled ? ", sampled" : "");
   print_result(r, o);
+  const int status = report_events(r, o);
   write_png_if_asked(r.solid, o, cap, {});
-  return 0;
+  return status;
 }
 
 app::Profile batch_profile(const BatchOptions& o) {
@@ -193,6 +217,7 @@ app::Profile batch_profile(const BatchOptions& o) {
   if (o.threads >= 0) profile.threads = o.threads;
   apply_dialect(profile, o.dialect);
   if (o.start_tool >= 0) profile.nc.start_tool = o.start_tool;
+  if (o.no_checks) profile.checks.enabled = false;
   return profile;
 }
 
@@ -270,9 +295,10 @@ int run_batch_command(const BatchOptions& o) {
   if (emulated) r.machining_time_s = emulated_time_s;
   app::write_batch_outputs(o.out, r, profile, program);
   print_result(r, o);
+  const int status = report_events(r, o);
   write_png_if_asked(r.solid, o, cap, app::final_tools(profile, path));
   if (o.view_window) return run_view_command(o, ViewCliOptions{});
-  return 0;
+  return status;
 }
 
 struct RunOptions {
@@ -609,6 +635,11 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
   batch->add_flag("--show-tool", b.show_tool, "--png: draw the tool at its last position (default: the part alone)");
   batch->add_flag("--no-tool", b.no_tool, "--png: no tool in the picture (the default)")->excludes("--show-tool");
   batch->add_flag("--view-window", b.view_window, "Then open the interactive viewer on the program (runs it again)");
+  batch->add_option("--fail-on", b.fail_on,
+                    "Exit with status 3 when the collision checks raise an error (error) or any event (warning)")
+      ->check(CLI::IsMember({"never", "error", "warning"}))
+      ->capture_default_str();
+  batch->add_flag("--no-checks", b.no_checks, "Skip the collision and process checks (profile [checks] enabled = false)");
   return batch;
 }
 

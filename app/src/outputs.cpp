@@ -80,6 +80,33 @@ std::vector<ChannelPath> load_channel_paths(const Profile& profile, Interpreter 
 
 nc::Toolpath demo_toolpath() { return nc::parse_movelist(kDemoProgram, "<built-in demo-pocket.moves>"); }
 
+namespace {
+
+// The events as metrics.json's "events" array (fields as the columns of events.csv).
+nlohmann::json events_json(const std::vector<verify::Event>& events) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const verify::Event& e : events) {
+    a.push_back({{"kind", verify::to_string(e.kind)},
+                 {"severity", verify::to_string(e.severity())},
+                 {"time_s", e.t_s},
+                 {"source", e.source},
+                 {"line", e.line},
+                 {"last_line", e.last_line},
+                 {"moves", e.moves},
+                 {"move", e.move},
+                 {"last_move", e.last_move},
+                 {"tool", e.tool},
+                 {"channel", e.channel},
+                 {"position_mm", {e.position.x, e.position.y, e.position.z}},
+                 {"volume_mm3", e.volume_mm3},
+                 {"depth_mm", e.depth_mm},
+                 {"region", e.region}});
+  }
+  return a;
+}
+
+}  // namespace
+
 std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program) {
   nlohmann::json j;
   j["lbrsim_version"] = version();
@@ -110,6 +137,11 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
   j["chain_offsets"] = r.stats.chain_offsets;
   j["threads"] = r.threads;
   j["peak_rss_mb"] = peak_rss_mb();
+  j["checks"] = profile.checks.enabled;
+  const verify::EventCounts counts = verify::count(r.events);
+  j["event_errors"] = counts.errors;
+  j["event_warnings"] = counts.warnings;
+  j["events"] = events_json(r.events);
   return j.dump(2) + "\n";
 }
 
@@ -150,6 +182,7 @@ void write_batch_outputs(const std::string& dir, const BatchResult& r, const Pro
   if (ec) throw std::runtime_error(dir + ": cannot create output directory: " + ec.message());
   write_file(dir + "/metrics.json", batch_metrics_json(r, profile, program));
   write_file(dir + "/levels.lbrs", geom::to_bytes(r.solid));
+  write_file(dir + "/events.csv", verify::events_csv(r.events));
 }
 
 }  // namespace lbr::app

@@ -10,6 +10,7 @@
 
 #include "cfg/table.hpp"
 #include "geom/config_toml.hpp"
+#include "verify/config_toml.hpp"
 #include "gfx/config_toml.hpp"
 #include "hal/config_toml.hpp"
 #include "kin/config_toml.hpp"
@@ -134,6 +135,7 @@ Profile parse_profile(const std::string& text, const std::string& name) {
   if (p.live.axes.empty()) p.live.axes = hal::default_axes();
   read_table(top, "threads", [&](cfg::Table& s) { hal::read_threads(s, p.live); });
   read_table(top, "render", [&](cfg::Table& s) { gfx::read_render(s, p.render); });
+  read_table(top, "checks", [&](cfg::Table& s) { verify::read_checks(s, p.checks); });
   top.reject_unknown();
   return p;
 }

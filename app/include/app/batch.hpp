@@ -11,6 +11,7 @@
 #include "motion/path_sweeps.hpp"
 #include "motion/tool_table.hpp"
 #include "nc/toolpath.hpp"
+#include "verify/events.hpp"
 
 namespace lbr::app {
 
@@ -24,6 +25,7 @@ struct BatchResult {
   std::uint64_t moves = 0;      // motion segments
   geom::SubtractStats stats;
   int threads = 1;              // kernel worker threads used
+  std::vector<verify::Event> events;  // collision and process checks (verify/), in move order
 };
 
 // Progress callback: fraction done in [0, 1].

@@ -20,6 +20,7 @@
 #include "nc/config.hpp"
 #include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
+#include "verify/collision.hpp"
 
 namespace lbr::app {
 
@@ -48,6 +49,7 @@ struct Profile {
   motion::ToolsConfig tooling; // [[tool]]: milling tools, lathe inserts, live-tool mounts (motion/config_toml.hpp)
   hal::LiveConfig live;        // [live], [[live.axis]], [threads]: `lbrsim run` (hal/config_toml.hpp)
   gfx::RenderThreadConfig render;  // [render]: the render thread's rate (gfx/config_toml.hpp)
+  verify::CheckConfig checks;      // [checks]: collision and process checks (verify/config_toml.hpp)
   std::vector<Channel> channels;   // [[channel]]; empty: one channel, the program given
 };
 

@@ -1,0 +1,95 @@
+// verify/collision.hpp — collision and process checks of each move against the stock as it
+// is at that moment (docs/verification.md).
+//
+// Checks: a rapid sweep that removes material (rapid-into-material); the non-cutting parts
+// of a milling tool, the shank (between the flutes' end and the gauge length, at the shank
+// diameter) and the holder (from the gauge length up, at the holder diameter), meeting
+// material (shank-in-material, holder-in-material). Turning inserts are not checked.
+//
+// The batch runner asks `check()` before subtracting a batch of moves. The stock before the
+// batch holds at least the material present at any move of it (cutting only removes), so a
+// move found clean against it is clean at its own moment. A move that meets material and is
+// not the first of the batch is not judged: `check()` returns its index, the caller
+// subtracts the moves before it and asks again, so every event is measured against the
+// exact stock of its moment and clean programs pay no extra kernel calls.
+//
+// Setup-time and batch-time code: allocates; not for the real-time path.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "geom/lbr_solid.hpp"
+#include "motion/path_sweeps.hpp"
+#include "motion/tool_table.hpp"
+#include "nc/toolpath.hpp"
+#include "verify/events.hpp"
+#include "verify/intrusion.hpp"
+
+namespace lbr::verify {
+
+struct CheckConfig {
+  bool enabled = true;
+  // Material closer than this to a sweep's boundary is not a finding: a rapid or a holder
+  // may graze a wall by less (chord tolerance of two polygonised circles, cusps) [mm].
+  double tolerance_mm = 0.01;
+};
+
+// Which program segment made a move: move ids → (source, segment), for the ids the batch
+// runner gives (docs/formats.md#move-ids): a path's segments get ids base + index + 1.
+class MoveIndex {
+ public:
+  // Ids base + 1 .. base + path.segments.size() belong to `path` (kept by reference).
+  void add(const nc::Toolpath& path, geom::MoveId base);
+  // The segment of move `id` and its program, or null when the id is not known.
+  [[nodiscard]] const nc::Segment* find(geom::MoveId id, const std::string** source) const noexcept;
+
+ private:
+  struct Range {
+    geom::MoveId base;
+    const nc::Toolpath* path;
+  };
+  std::vector<Range> ranges_;  // ascending base
+};
+
+class CollisionChecker {
+ public:
+  // Builds the shank and holder shapes of every milling tool of `tools` (which must outlive
+  // the checker).
+  CollisionChecker(const CheckConfig& config, const motion::ToolTable& tools, const MoveIndex& index);
+
+  // Checks moves [from, to) against `solid`, the stock just before moves[from]. Returns the
+  // index of the first move after `from` that meets material (its check must be repeated
+  // once the moves before it are subtracted), or `to` when there is none. Findings of
+  // moves[from] and of the clean moves are final and go to `events`.
+  std::size_t check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves, std::size_t from,
+                    std::size_t to, std::vector<Event>& events);
+
+  [[nodiscard]] const CheckConfig& config() const noexcept { return config_; }
+
+ private:
+  struct Parts {
+    geom::CutterShape shank, holder;
+    double shank_from_mm = 0.0;   // shank bottom above the tip [mm]
+    double holder_from_mm = 0.0;  // holder face above the tip [mm]
+    bool has_shank = false;
+  };
+  struct Finding {
+    EventKind kind;
+    Intrusion what;
+  };
+  // The findings of one move against `solid`; returns how many (0..3) were written.
+  int findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, Finding (&out)[3]);
+  [[nodiscard]] Event event_of(const motion::TimedSweep& m, const Finding& f) const;
+
+  CheckConfig config_;
+  const motion::ToolTable& tools_;
+  const MoveIndex& index_;
+  std::map<int, Parts> parts_;
+  IntrusionProbe probe_;
+};
+
+}  // namespace lbr::verify

@@ -1,0 +1,159 @@
+#include "verify/intrusion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "geom/units.hpp"
+
+namespace lbr::verify {
+
+namespace {
+
+geom::Rect rect_of(const geom::Box3& b) {
+  geom::Rect r;
+  r.add(geom::Point{geom::to_units(b.lo.x), geom::to_units(b.lo.y)});
+  r.add(geom::Point{geom::to_units(b.hi.x), geom::to_units(b.hi.y)});
+  return r;
+}
+
+geom::Rect rect_of(const geom::Paths& paths) {
+  geom::Rect r;
+  for (const geom::Path& p : paths) r.add(geom::bounds_of(p));
+  return r;
+}
+
+// One Sutherland–Hodgman pass: the part of `in` on the inner side of the line x = c
+// (axis 0) or y = c (axis 1); `keep_greater` picks the side.
+void clip_half(const geom::Path& in, int axis, geom::Coord c, bool keep_greater, geom::Path& out) {
+  out.clear();
+  if (in.empty()) return;
+  const auto coord = [axis](const geom::Point& p) { return axis == 0 ? p.X : p.Y; };
+  const auto inside = [&](const geom::Point& p) { return keep_greater ? coord(p) >= c : coord(p) <= c; };
+  geom::Point prev = in.back();
+  for (const geom::Point& cur : in) {
+    if (inside(cur) != inside(prev)) {  // the edge crosses the line: add the crossing
+      const double t = static_cast<double>(c - coord(prev)) / static_cast<double>(coord(cur) - coord(prev));
+      const double ox = static_cast<double>(prev.X) + t * static_cast<double>(cur.X - prev.X);
+      const double oy = static_cast<double>(prev.Y) + t * static_cast<double>(cur.Y - prev.Y);
+      out.push_back(axis == 0 ? geom::Point{c, std::llround(oy)} : geom::Point{std::llround(ox), c});
+    }
+    if (inside(cur)) out.push_back(cur);
+    prev = cur;
+  }
+}
+
+}  // namespace
+
+// The part of contour `p` inside `r` (Sutherland–Hodgman). For a non-convex contour the
+// result may hold zero-width bridges along r's sides, but its winding number at every point
+// inside r is p's, so the area it shares with a clip polygon inside r is exact. A dense
+// finishing cell holds contours of thousands of vertices; the clip then sees a few dozen.
+void IntrusionProbe::clip_to_rect(const geom::Path& p, const geom::Rect& r) {
+  clip_half(p, 0, r.x0, true, tmp_a_);
+  clip_half(tmp_a_, 0, r.x1, false, tmp_b_);
+  clip_half(tmp_b_, 1, r.y0, true, tmp_a_);
+  clip_half(tmp_a_, 1, r.y1, false, tmp_b_);
+  if (tmp_b_.size() >= 3) subject_.push_back(tmp_b_);
+}
+
+void IntrusionProbe::regions_under(const geom::LbrSolid& solid, const geom::Rect& r) {
+  regions_.clear();
+  for (int region = 0; region < solid.regions(); ++region)
+    if (solid.region_rect(region).intersects(r)) regions_.push_back(region);
+  region_volume_.assign(regions_.size(), 0.0);
+}
+
+void IntrusionProbe::cell_subject(const geom::Cell& cell, const geom::Rect& r) {
+  subject_.clear();
+  for (const geom::Polygon& p : cell.polys) {
+    if (!p.bbox.intersects(r)) continue;  // holes lie inside their outer contour
+    clip_to_rect(p.outer.pts, r);
+    for (const geom::Contour& h : p.holes) clip_to_rect(h.pts, r);
+  }
+}
+
+double IntrusionProbe::subject_overlap_mm2(const geom::Paths& clip) {
+  if (subject_.empty()) return 0.0;
+  clipper_.Clear();
+  clipper_.AddPaths(subject_, ClipperLib::ptSubject, true);
+  clipper_.AddPaths(clip, ClipperLib::ptClip, true);
+  result_.clear();
+  clipper_.Execute(ClipperLib::ctIntersection, result_, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  double units2 = 0.0;
+  for (const geom::Path& p : result_) units2 += ClipperLib::Area(p);
+  return geom::area_to_mm2(std::abs(units2));
+}
+
+// Each convex section polygon moved inwards by the margin (pieces thinner than twice the
+// margin vanish).
+void IntrusionProbe::shrink_section(double margin_mm) {
+  shrunk_.clear();
+  geom::Paths piece;
+  for (const geom::Path& p : section_) {
+    offset_.Clear();
+    offset_.AddPath(p, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+    piece.clear();
+    offset_.Execute(piece, -margin_mm * geom::kUnitsPerMm);
+    for (geom::Path& q : piece) shrunk_.push_back(std::move(q));
+  }
+}
+
+int IntrusionProbe::top_material_level(const geom::LbrSolid& solid, int from) const {
+  for (int level = from; level >= 0; --level)
+    for (int region : regions_)
+      if (!solid.cell(region, level).bbox.empty()) return level;
+  return -1;
+}
+
+Intrusion IntrusionProbe::measure(const geom::LbrSolid& solid, const geom::Sweep& sweep, double margin_mm) {
+  Intrusion out;
+  const geom::Box3& b = sweep.bounds();
+  const double z_lo = std::max(b.lo.z, solid.z_bottom_mm());
+  const double z_hi = std::min(b.hi.z, solid.z_top_mm());
+  if (b.empty() || z_lo > z_hi) return out;
+  const geom::Rect xy = rect_of(b);
+  regions_under(solid, xy);
+  if (regions_.empty()) return out;
+  // Nothing to meet above the highest material of the regions under the sweep: the shank
+  // and holder of a finishing tool mostly stay there, and are then judged without a clip.
+  const int highest = top_material_level(solid, solid.level_at(z_hi));
+  if (highest < 0) return out;
+  double hit_lo = 0.0, hit_hi = 0.0;
+  for (int level = solid.level_at(z_lo); level <= highest; ++level) {
+    const double z = solid.level_z_mm(level);
+    if (z < b.lo.z || z > b.hi.z) continue;
+    const bool material = std::any_of(regions_.begin(), regions_.end(),
+                                      [&](int region) { return solid.cell(region, level).bbox.intersects(xy); });
+    if (!material) continue;
+    section_.clear();
+    if (sweep.section(z, section_, scratch_) == 0) continue;
+    const geom::Rect sb = rect_of(section_);
+    double level_mm3 = 0.0;
+    bool shrunk = false;
+    for (std::size_t k = 0; k < regions_.size(); ++k) {
+      const geom::Cell& cell = solid.cell(regions_[k], level);
+      if (!cell.bbox.intersects(sb)) continue;
+      cell_subject(cell, sb);
+      const double v = subject_overlap_mm2(section_) * solid.level_thickness_mm(level);
+      if (v <= 0.0) continue;
+      region_volume_[k] += v;
+      level_mm3 += v;
+      if (out.deep_mm3 > 0.0) continue;  // a finding already: only the volume is still needed
+      if (!shrunk) shrink_section(margin_mm), shrunk = true;
+      out.deep_mm3 += subject_overlap_mm2(shrunk_) * solid.level_thickness_mm(level);
+    }
+    if (level_mm3 <= 0.0) continue;
+    const double bottom = solid.level_bottom_mm(level), top = bottom + solid.level_thickness_mm(level);
+    if (out.volume_mm3 == 0.0) hit_lo = bottom, hit_hi = top;
+    hit_lo = std::min(hit_lo, bottom);
+    hit_hi = std::max(hit_hi, top);
+    out.volume_mm3 += level_mm3;
+  }
+  if (out.volume_mm3 <= 0.0) return out;
+  out.depth_mm = hit_hi - hit_lo;
+  const auto most = std::max_element(region_volume_.begin(), region_volume_.end());
+  out.region = regions_[static_cast<std::size_t>(most - region_volume_.begin())];
+  return out;
+}
+
+}  // namespace lbr::verify
