@@ -126,7 +126,6 @@ void PathStreamer::loop() {
   std::vector<geom::SweepRef> batch;
   batch.reserve(4096);
   batch_ms_.reserve(1 << 16);
-  const auto start = clock::now();
   const auto tick = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(opt_.tick_s));
   auto next = clock::now(), prev = next;
   double sim = 0.0;  // simulated machining time reached [s]
