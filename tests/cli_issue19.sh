@@ -110,7 +110,7 @@ can_hint)  # item 7: a CAN interface that cannot be opened says what to do
 small)  # item 8
   "$LBRSIM" batch --quiet --out q/ >log 2>&1 || fail "batch: $(cat log)"
   grep -q "\[info\]" log && fail "--quiet printed info lines: $(grep info log)"
-  grep -q "wrote q/metrics.json and q/levels.lbrs" log || fail "paths: $(grep wrote log)"
+  grep -q "wrote q/metrics.json, q/levels.lbrs and q/events.csv" log || fail "paths: $(grep wrote log)"
   grep -q "//" log && fail "double slash: $(grep // log)"
   cd "$SRC" && for p in bench-out/fig4.csv lbrsim-frame-000001.png lbrsim-out/metrics.json; do
     git check-ignore -q "$p" 2>/dev/null || [ ! -d .git ] || fail "$p not ignored by .gitignore"
