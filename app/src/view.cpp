@@ -139,7 +139,9 @@ void PathStreamer::loop() {
     const auto now = clock::now();
     if (opt_.control != nullptr && opt_.control->restart.exchange(false)) {
       restart(i, last);
-      sim = 0.0;
+      // Just before the start: the samples at t = 0 run with the first tick that advances
+      // (a restart while paused must leave the stock untouched).
+      sim = -1e-9;
       tool_count = 0;
       done_.store(false, std::memory_order_release);
     }
@@ -162,7 +164,7 @@ void PathStreamer::loop() {
       stats.sample_rate_hz = speed / opt_.sample_period_s;
       stats.samples = i;
     }
-    stats.machining_s = std::min(sim, duration_s_);
+    stats.machining_s = std::clamp(sim, 0.0, duration_s_);
     stats.paused = opt_.control != nullptr && opt_.control->paused.load(std::memory_order_relaxed);
     const std::span<const gfx::ToolState> shown(tools.data(), tool_count);
     // Publish every tick: a refused publish (render side busy) loses nothing.
