@@ -9,7 +9,7 @@ import time
 import linuxcnc
 
 prog, out = os.environ["LREF_PROG"], os.environ["LREF_OUT"]
-limit_s = float(os.environ.get("LREF_LIMIT_S", "600"))
+limit_s = float(os.environ.get("LREF_LIMIT_S", "180"))
 s, c, e = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
 errors = []
 
