@@ -73,7 +73,7 @@ TEST(LatheG7x, G72StepRemovesTheAnalyticVolume) {
 }
 
 TEST(LatheG7x, G71TaperThenG70RemovesTheAnalyticVolume) {
-  expect_volume(std::string(kHead) + kTaper + "G0 X44 Z2\nG71 Q200 X44 Z2 I1.5 R0.3\nG70 Q200\nG0 X60 Z20\nM2\n",
+  expect_volume(std::string(kHead) + kTaper + "G0 X44 Z2\nG71 Q200 X44 Z2 I1.5 R0.3\nG70 Q200 X44 Z2\nG0 X60 Z20\nM2\n",
                 taper_mm3());
 }
 
@@ -81,37 +81,77 @@ TEST(LatheG7x, G72TaperRemovesTheAnalyticVolume) {
   expect_volume(std::string(kHead) + kTaper + "G0 X44 Z2\nG72 Q200 X44 Z2 I0.7 R0.2\nG0 X60 Z20\nM2\n", taper_mm3());
 }
 
-TEST(LatheG7x, G70AloneFollowsTheProfile) {
-  // Finishing alone from the start point: rapid to the profile's start, along it, back.
-  nc::GcodeOptions o;
-  const nc::Toolpath tp =
-      nc::interpret_gcode("G18 G8 G21 G90\nF100\nO1 SUB\n G0 X5 Z1\n G1 Z-10\n X12\nO1 ENDSUB\nG70 Q1 X15 Z3\nM2\n", "t.ngc", o);
-  ASSERT_EQ(tp.segments.size(), 6u);
-  const double want[6][2] = {{15, 3}, {5, 1}, {5, -10}, {12, -10}, {15, -10}, {15, 3}};
-  for (std::size_t i = 0; i < 6; ++i) {
-    EXPECT_NEAR(tp.segments[i].end[nc::X], want[i][0], 1e-12) << i;
-    EXPECT_NEAR(tp.segments[i].end[nc::Z], want[i][1], 1e-12) << i;
+// The segments' end points and kinds, consecutive repeats dropped (rs274 repeats positions).
+std::vector<std::array<double, 3>> path_of(const nc::Toolpath& tp) {
+  std::vector<std::array<double, 3>> out;
+  for (const nc::Segment& s : tp.segments) {
+    const std::array<double, 3> p{s.end[nc::X], s.end[nc::Z], s.kind == nc::SegmentKind::Feed ? 1.0 : 0.0};
+    if (!out.empty() && std::abs(out.back()[0] - p[0]) < 1e-9 && std::abs(out.back()[1] - p[1]) < 1e-9) continue;
+    out.push_back(p);
   }
+  return out;
+}
+
+// The built-in path against hand-computed feeds, then against rs274's path (when installed):
+// the same moves within 1e-4 mm (rs274 prints 4 decimals).
+void expect_path(const std::string& program, const std::vector<std::array<double, 2>>& want_feeds) {
+  const nc::GcodeOptions o;
+  const std::vector<std::array<double, 3>> ours = path_of(nc::interpret_gcode(program, "t.ngc", o));
+  std::vector<std::array<double, 2>> feeds;
+  for (const auto& p : ours)
+    if (p[2] > 0.5) feeds.push_back({p[0], p[1]});
+  ASSERT_EQ(feeds.size(), want_feeds.size());
+  for (std::size_t i = 0; i < feeds.size(); ++i) {
+    EXPECT_NEAR(feeds[i][0], want_feeds[i][0], 1e-9) << i;
+    EXPECT_NEAR(feeds[i][1], want_feeds[i][1], 1e-9) << i;
+  }
+  if (nc::find_rs274().empty()) return;
+  const std::string path = ::testing::TempDir() + "g7x_path.ngc";
+  std::ofstream(path) << program;
+  const std::vector<std::array<double, 3>> theirs = path_of(nc::run_rs274(path, o));
+  ASSERT_EQ(ours.size(), theirs.size());
+  for (std::size_t i = 0; i < ours.size(); ++i)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(ours[i][k], theirs[i][k], 1e-4) << i;
+}
+
+const char* kSmall = "G18 G8 G21 G90\nF100\nO1 SUB\n G0 X5 Z1\n G1 Z-10\n X12\n Z-20\n X15\nO1 ENDSUB\nG0 X20 Z3\n";
+
+TEST(LatheG7x, G70FollowsTheProfileFromTheStartPoint) {
+  expect_path(std::string(kSmall) + "G70 Q1 X15 Z3 P2\nG0 X30\nM2\n",
+              {{5, -10}, {12, -10}, {12, -20}, {15, -20}, {5, -10}, {12, -10}, {12, -20}, {15, -20}});
+}
+
+TEST(LatheG7x, G70ApproachesAProfileRunningBackAlongZFirst) {
+  const std::string face = "G18 G8 G21 G90\nF100\nO1 SUB\n G0 X15 Z-6\n G1 X8 Z-5\n Z0\n X3 Z1.2\nO1 ENDSUB\nG0 X20 Z3\n";
+  expect_path(face + "G70 Q1 X25 Z5\nG0 X30\nM2\n", {{8, -5}, {8, 0}, {3, 1.2}});
+  expect_path(face + "G70 Q1 X15 Z3\nG0 X30\nM2\n", {{8, -5}, {8, 0}, {3, 1.2}});
+  expect_path("G18 G8 G21 G90\nF200\nO2 SUB\n G0 X21 Z-30\n G1 X10 Z-10\n Z2\nO2 ENDSUB\nG0 X22 Z2\nG70 Q2 X22 Z2\nG0 X60\nM2\n",
+              {{10, -10}, {10, 2}});
 }
 
 TEST(LatheG7x, G71PassesEndOnTheProfile) {
-  // Radius mode, start X15 Z3, I2: passes at X13, 11, 9, 7 from Z3 to the profile (X13 meets
-  // it at Z-20, the others at the shoulder Z-10), each retracting R0.5; then one pass along
-  // the profile. The feeds' end points, by hand:
-  nc::GcodeOptions o;
-  const nc::Toolpath tp = nc::interpret_gcode(
-      "G18 G8 G21 G90\nF100\nO1 SUB\n G0 X5 Z1\n G1 Z-10\n X12\n Z-20\n X15\nO1 ENDSUB\nG71 Q1 X15 Z3 I2 R0.5\nM2\n",
-      "t.ngc", o);
-  std::vector<std::array<double, 2>> feeds;
-  for (const nc::Segment& s : tp.segments)
-    if (s.kind == nc::SegmentKind::Feed) feeds.push_back({s.end[nc::X], s.end[nc::Z]});
-  const std::vector<std::array<double, 2>> want = {{13, -20}, {11, -10}, {9, -10}, {7, -10},
-                                                   {5, -10},  {12, -10}, {12, -20}, {15, -20}};
-  ASSERT_EQ(feeds.size(), want.size());
-  for (std::size_t i = 0; i < want.size(); ++i) {
-    EXPECT_NEAR(feeds[i][0], want[i][0], 1e-12) << i;
-    EXPECT_NEAR(feeds[i][1], want[i][1], 1e-12) << i;
-  }
+  // Start X15 Z3 (radius mode), I2: passes at X15, 13, 11, 9, 7, each from the line between the
+  // start point and the profile's start (X5 Z1) to the profile (Z-20 at X15 and 13, the
+  // shoulder Z-10 below), retracting R0.5 at 45 degrees; then along the profile.
+  expect_path(std::string(kSmall) + "G71 Q1 X15 Z3 I2 R0.5\nG0 X30\nM2\n",
+              {{15, -20}, {13, -20}, {11, -10}, {9, -10}, {7, -10}, {5, -10}, {12, -10}, {12, -20}, {15, -20}});
+}
+
+TEST(LatheG7x, G72PassesEndOnTheProfile) {
+  // The profile does not run towards the start level (Z3): LinuxCNC makes no roughing passes,
+  // only the approach at the start level, a feed to the profile's start and the profile.
+  expect_path(std::string(kSmall) + "G72 Q1 X15 Z3 I1.5 R0.5\nG0 X30\nM2\n",
+              {{5, 1}, {5, -10}, {12, -10}, {12, -20}, {15, -20}});
+}
+
+TEST(LatheG7x, G72PassesAlongXEndOnTheProfile) {
+  // Facing: the profile runs from the outside (X15 Z-6) up to the start level's side (X3 Z1.2);
+  // passes along X at Z levels 3 (start), 1.5 (both above the profile: none), 0, -1.5, -3,
+  // -4.5, from X15 to the profile (X3 above it: the profile is closed by a line from its end
+  // to the start level) retracting R0.5 at 45 degrees; then along the profile and that line.
+  expect_path("G18 G8 G21 G90\nF100\nO1 SUB\n G0 X15 Z-6\n G1 X8 Z-5\n Z0\n X3 Z1.2\nO1 ENDSUB\nG0 X20 Z3\n"
+              "G72 Q1 X15 Z3 I1.5 R0.5\nG0 X30\nM2\n",
+              {{3, 3}, {3, 1.5}, {8, 0}, {8, -1.5}, {8, -3}, {8, -4.5}, {8, -5}, {8, 0}, {3, 1.2}, {3, 3}});
 }
 
 TEST(LatheG7x, RefusesWhatItDoesNotDo) {
