@@ -119,6 +119,8 @@ const char* kSmall = "G18 G8 G21 G90\nF100\nO1 SUB\n G0 X5 Z1\n G1 Z-10\n X12\n 
 TEST(LatheG7x, G70FollowsTheProfileFromTheStartPoint) {
   expect_path(std::string(kSmall) + "G70 Q1 X15 Z3 P2\nG0 X30\nM2\n",
               {{5, -10}, {12, -10}, {12, -20}, {15, -20}, {5, -10}, {12, -10}, {12, -20}, {15, -20}});
+  // One pass (P1) runs at E = 0 from the profile whatever D is.
+  expect_path(std::string(kSmall) + "G70 Q1 X15 Z3 D1 P1\nG0 X30\nM2\n", {{5, -10}, {12, -10}, {12, -20}, {15, -20}});
 }
 
 TEST(LatheG7x, G70ApproachesAProfileRunningBackAlongZFirst) {
@@ -168,7 +170,9 @@ TEST(LatheG7x, RefusesWhatItDoesNotDo) {
   EXPECT_EQ(error_of(sub + "G71 Q1 X15 Z3 D0.5\n"),
             "t.ngc:8: 'G71' with D (finishing allowance) is not in the built-in interpreter; use --interpreter rs274");
   EXPECT_EQ(error_of(sub + "G70 Q1 X15 Z3 D1 P2\n"),
-            "t.ngc:8: 'G70' with D or E (passes away from the profile) is not in the built-in interpreter; use --interpreter rs274");
+            "t.ngc:8: 'G70' with passes away from the profile (E, or D with P > 1) is not in the built-in interpreter; use --interpreter rs274");
+  EXPECT_EQ(error_of(sub + "G70 Q1 X15 Z3 E0.1\n"),
+            "t.ngc:8: 'G70' with passes away from the profile (E, or D with P > 1) is not in the built-in interpreter; use --interpreter rs274");
   EXPECT_EQ(error_of(sub + "G71 Q1 X8 Z3\n"),
             "t.ngc:8: 'G71': the start point lies within the profile's range across the passes");
   EXPECT_EQ(error_of(sub + "G17 G71 Q1 X15 Z3\n"), "t.ngc:8: 'G71' needs the XZ plane (G18)");

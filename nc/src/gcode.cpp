@@ -1170,9 +1170,12 @@ class Interpreter {
     auto word = [&](char L, double dflt) { return has(b, L) ? len(b, L) : dflt; };
     try {
       if (g == "G70") {
-        if (word('D', 0.0) != 0.0 || word('E', 0.0) != 0.0)
-          fail("'G70' with D or E (passes away from the profile) is not in the built-in interpreter" + std::string(kUseRs274));
+        // Pass i of P runs at E + (D - E)(P - i)/P from the profile (LinuxCNC): on it when E = 0
+        // and D = 0 or P = 1.
         const int passes = has(b, 'P') ? integer(b, 'P', 1, 1000) : 1;
+        if (word('E', 0.0) != 0.0 || (word('D', 0.0) != 0.0 && passes > 1))
+          fail("'G70' with passes away from the profile (E, or D with P > 1) is not in the built-in interpreter" +
+               std::string(kUseRs274));
         std::vector<detail::ProfilePoint> out;
         for (int i = 0; i < passes; ++i) {
           const std::vector<detail::ProfilePoint> one = detail::lathe_finishing(profile, s);
