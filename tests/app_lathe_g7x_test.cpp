@@ -95,7 +95,8 @@ std::vector<std::array<double, 3>> path_of(const nc::Toolpath& tp) {
 // The built-in path against hand-computed feeds, then against rs274's path (when installed):
 // the same moves within 1e-4 mm (rs274 prints 4 decimals).
 void expect_path(const std::string& program, const std::vector<std::array<double, 2>>& want_feeds) {
-  const nc::GcodeOptions o;
+  nc::GcodeOptions o;
+  o.machine = nc::MachineKind::Lathe;
   const std::vector<std::array<double, 3>> ours = path_of(nc::interpret_gcode(program, "t.ngc", o));
   std::vector<std::array<double, 2>> feeds;
   for (const auto& p : ours)
@@ -136,6 +137,13 @@ TEST(LatheG7x, G71PassesEndOnTheProfile) {
   // start point and the profile's start (X5 Z1) to the profile (Z-20 at X15 and 13, the
   // shoulder Z-10 below), retracting R0.5 at 45 degrees; then along the profile.
   expect_path(std::string(kSmall) + "G71 Q1 X15 Z3 I2 R0.5\nG0 X30\nM2\n",
+              {{15, -20}, {13, -20}, {11, -10}, {9, -10}, {7, -10}, {5, -10}, {12, -10}, {12, -20}, {15, -20}});
+}
+
+TEST(LatheG7x, G71InDiameterModeStepsIAsARadius) {
+  // G7: X words are diameters; I and R are not halved (as rs274).
+  expect_path("G18 G7 G21 G90\nF100\nO1 SUB\n G0 X10 Z1\n G1 Z-10\n X24\n Z-20\n X30\nO1 ENDSUB\nG0 X40 Z3\n"
+              "G71 Q1 X30 Z3 I2 R0.5\nG0 X60\nM2\n",
               {{15, -20}, {13, -20}, {11, -10}, {9, -10}, {7, -10}, {5, -10}, {12, -10}, {12, -20}, {15, -20}});
 }
 
