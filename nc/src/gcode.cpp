@@ -18,6 +18,7 @@
 
 #include "cutter_comp.hpp"
 #include "fanuc.hpp"
+#include "lathe_profile.hpp"
 #include "ngc_control.hpp"
 #include "ngc_expr.hpp"
 #include "path_builder.hpp"
@@ -386,6 +387,7 @@ class Interpreter {
     if (std::abs(w.value * 10.0 - c) > 1e-6) return -1;
     switch (c) {
       case 0: case 10: case 20: case 30: case 330: case 331: case 760: case 800: case 810: case 820: case 830: case 730:
+      case 700: case 710: case 720:
         return kMotion;
       case 170: case 180: case 190: return kPlane;
       case 900: case 910: return kDistance;
@@ -408,8 +410,8 @@ class Interpreter {
   std::string unsupported_g(const Word& w) const {
     const int c = code10(w);
     const char* why = "not supported by the built-in interpreter";
-    if (c == 700 || c == 710 || c == 720)
-      return "unsupported word '" + w.text + "' (lathe finishing/roughing cycles G70-G72 are not in the built-in interpreter" +
+    if (c == 711 || c == 712 || c == 721 || c == 722)
+      return "unsupported word '" + w.text + "' (lathe roughing cycle variants G71.1/G71.2/G72.1/G72.2 are not in the built-in interpreter" +
              kUseRs274 + ")";
     if (c == 381 || c == 382 || c == 383 || c == 384) why = "probing";
     else if (c == 431) why = "dynamic tool length offset";
@@ -710,6 +712,10 @@ class Interpreter {
 
   // 8. G10, G28/G30, G53; 9. motion
   void move(Block& b, const Codes& k) {
+    if (k.g[kMotion] && is_lathe_profile_cycle(code10(*k.g[kMotion]))) {
+      lathe_profile_cycle(b, code10(*k.g[kMotion]), k.f_in_block);
+      return;
+    }
     if (k.g[kMotion]) {
       const int c = code10(*k.g[kMotion]);
       if (c != motion_ && is_cycle(c)) cycle_sticky_ = {};
@@ -1001,6 +1007,10 @@ class Interpreter {
 
   void move_line(int c, const AxisVector& t, bool f_in_block) {
     arc_after_g40_ = false;
+    if (capture_ != nullptr) {
+      capture_point(t, c == 0);
+      return;
+    }
     if (comp_.active()) {
       comp_.line(line_, c == 0, t, c == 0 ? 0.0 : feed_for_move("G1", f_in_block), inverse_time_);
     } else if (c == 0) {
@@ -1122,8 +1132,118 @@ class Interpreter {
       if (err > 0.002 && err > 0.001 * r0)
         fail("'" + g + "' end point is off the circle: start radius " + fmt(r0) + " mm, end radius " + fmt(r1) + " mm");
     }
-    if (comp_.active()) comp_.arc(line_, end, cu, cv, motion_ == 30 ? turns : -turns, f, inverse_time_);
+    if (capture_ != nullptr) capture_arc(ax, start, end, cu, cv, motion_ == 30 ? turns : -turns);
+    else if (comp_.active()) comp_.arc(line_, end, cu, cv, motion_ == 30 ? turns : -turns, f, inverse_time_);
     else b_.arc(line_, plane_, end, cu, cv, motion_ == 30 ? turns : -turns, f, inverse_time_);
+  }
+
+  // ---- G70/G71/G72 lathe cycles (lathe_profile.hpp) ----------------------------------------
+  static bool is_lathe_profile_cycle(int c) { return c == 700 || c == 710 || c == 720; }
+
+  // The profile: the subroutine Q runs with its moves recorded (not cut), starting from the
+  // cycle's start point; then the cycle's own moves are cut.
+  void lathe_profile_cycle(Block& b, int c, bool f_in_block) {
+    const std::string g = c == 700 ? "G70" : c == 710 ? "G71" : "G72";
+    if (plane_ != Plane::ZX) fail("'" + g + "' needs the XZ plane (G18)");
+    if (comp_.active()) fail("'" + g + "' cannot be used with cutter radius compensation on (G40 first)");
+    if (!has(b, 'Q')) fail("'" + g + "' needs Q (the number of the profile's subroutine)");
+    const int q = integer(b, 'Q', 0, 99999999);
+    const AxisVector before = b_.position();
+    const AxisVector start = (has(b, 'X') || has(b, 'Z')) ? target(b, false) : before;
+    const bool g72 = c == 720;
+    const detail::ProfilePoint s = profile_point(start, g72, true);
+    const std::vector<detail::ProfilePoint> moves = lathe_cycle_moves(b, g, s, capture_profile(q, start, g72));
+    b_.set_position(before);
+    b_.rapid(line_, start);
+    const double f = feed_for_move(g, f_in_block);
+    for (const detail::ProfilePoint& p : moves) {
+      AxisVector v = b_.position();
+      v[g72 ? Z : X] = p.level;
+      v[g72 ? X : Z] = p.pass;
+      if (p.rapid) b_.rapid(line_, v);
+      else b_.feed(line_, v, f, inverse_time_);
+    }
+  }
+
+  std::vector<detail::ProfilePoint> lathe_cycle_moves(Block& b, const std::string& g, const detail::ProfilePoint& s,
+                                                      const std::vector<detail::ProfilePoint>& profile) {
+    auto word = [&](char L, double dflt) { return has(b, L) ? len(b, L) : dflt; };
+    try {
+      if (g == "G70") {
+        // Pass i of P runs at E + (D - E)(P - i)/P from the profile (LinuxCNC): on it when E = 0
+        // and D = 0 or P = 1.
+        const int passes = has(b, 'P') ? integer(b, 'P', 1, 1000) : 1;
+        if (word('E', 0.0) != 0.0 || (word('D', 0.0) != 0.0 && passes > 1))
+          fail("'G70' with passes away from the profile (E, or D with P > 1) is not in the built-in interpreter" +
+               std::string(kUseRs274));
+        std::vector<detail::ProfilePoint> out;
+        for (int i = 0; i < passes; ++i) {
+          const std::vector<detail::ProfilePoint> one = detail::lathe_finishing(profile, s);
+          out.insert(out.end(), one.begin(), one.end());
+        }
+        return out;
+      }
+      if (word('D', 0.0) != 0.0)
+        fail("'" + g + "' with D (finishing allowance) is not in the built-in interpreter" + std::string(kUseRs274));
+      return detail::lathe_roughing(profile, s, word('I', 1.0), word('R', 0.5));
+    } catch (const std::invalid_argument& e) {
+      fail("'" + g + "': " + e.what());
+    }
+  }
+
+  detail::ProfilePoint profile_point(const AxisVector& v, bool g72, bool rapid) const {
+    detail::ProfilePoint p;
+    p.level = v[g72 ? Z : X], p.pass = v[g72 ? X : Z], p.rapid = rapid;
+    return p;
+  }
+
+  std::vector<detail::ProfilePoint> capture_profile(int q, const AxisVector& start, bool g72) {
+    std::vector<detail::ProfilePoint> profile;
+    const int motion = motion_, line = line_;
+    b_.set_position(start);
+    capture_ = &profile;
+    capture_g72_ = g72;
+    try {
+      flow_.call_now(std::to_string(q));
+    } catch (...) {
+      capture_ = nullptr;
+      throw;
+    }
+    capture_ = nullptr;
+    motion_ = motion, line_ = line;
+    return profile;
+  }
+
+  void capture_point(const AxisVector& t, bool rapid) {
+    capture_->push_back(profile_point(t, capture_g72_, rapid));
+    b_.set_position(t);
+  }
+
+  // An arc of the profile as chords at most 0.001 mm from it (rotation > 0: counter-clockwise).
+  void capture_arc(const detail::PlaneAxes& ax, const AxisVector& start, const AxisVector& end, double cu, double cv,
+                   int rotation) {
+    const double r = std::hypot(start[ax.u] - cu, start[ax.v] - cv);
+    const double a0 = std::atan2(start[ax.v] - cv, start[ax.u] - cu);
+    double a1 = std::atan2(end[ax.v] - cv, end[ax.u] - cu);
+    const double two_pi = 2.0 * std::acos(-1.0);
+    if (rotation > 0) {
+      while (a1 <= a0 + 1e-12) a1 += two_pi;
+      a1 += two_pi * (rotation - 1);
+    } else {
+      while (a1 >= a0 - 1e-12) a1 -= two_pi;
+      a1 -= two_pi * (-rotation - 1);
+    }
+    const double step = 2.0 * std::acos(std::max(0.0, 1.0 - 0.001 / std::max(r, 1e-9)));
+    const long n = std::max(1L, static_cast<long>(std::ceil(std::abs(a1 - a0) / std::max(step, 1e-6))));
+    for (long i = 1; i <= n; ++i) {
+      AxisVector p = i == n ? end : start;
+      if (i < n) {
+        const double a = a0 + (a1 - a0) * static_cast<double>(i) / static_cast<double>(n);
+        p[ax.u] = cu + r * std::cos(a);
+        p[ax.v] = cv + r * std::sin(a);
+      }
+      capture_point(p, false);
+    }
   }
 
   // Drilling cycles in the selected plane, as LinuxCNC: the hole axis w is Z in G17, Y in G18,
@@ -1251,6 +1371,8 @@ class Interpreter {
   detail::ControlFlow flow_;
   detail::CutterComp comp_{b_, [this](const std::string& m) { fail(m); }};
   bool arc_after_g40_ = false;  // the move after G40 must be straight (LinuxCNC)
+  std::vector<detail::ProfilePoint>* capture_ = nullptr;  // G70-G72: the profile subroutine's moves go here
+  bool capture_g72_ = false;
   std::map<int, ModalState> saved_states_;  // M70/M73, per call level
   int comp_code_ = 400;                      // G41/G42/G41.1/G42.1 x 10 while compensation is on
   std::vector<detail::ParamAssign> pending_;

@@ -399,6 +399,21 @@ void ControlFlow::call(const OWord& o) {
   stack_.push_back(activation(file, at + 1, o.label));
 }
 
+void ControlFlow::call_now(const std::string& label) {
+  if (call_level() >= kMaxCallDepth) fail("o" + label + ": subroutine calls nested deeper than " + std::to_string(kMaxCallDepth));
+  std::size_t at = 0;
+  const NgcFile* file = find_sub(label, at);
+  const std::size_t depth = stack_.size();
+  const std::size_t pc = stack_.back().pc;
+  params_.push_frame({});
+  params_.set_named("_VALUE_RETURNED", 0.0);
+  stack_.push_back(activation(file, at + 1, label));
+  while (stack_.size() > depth) {
+    if (!step()) fail("the program ends inside subroutine o" + label);
+  }
+  stack_.back().pc = pc;  // leave() moved the caller on; the calling block is not done
+}
+
 void ControlFlow::leave(const OWord& o) {
   if (stack_.size() <= 1) fail(owtext(o) + " outside a subroutine");
   // LinuxCNC lets 'return' carry any label (retval.ngc: o1010 return inside o1000); endsub

@@ -86,6 +86,10 @@ class ControlFlow {
 
   [[noreturn]] void fail(const std::string& msg) const;
 
+  // Runs subroutine `label` (no arguments) to its return from inside the block being
+  // executed (the G70-G72 profile), then goes on with that block.
+  void call_now(const std::string& label);
+
   // Called when a subroutine returns (endsub, return), with the call level being left
   // (M73 restores the modal state saved at that level).
   void on_leave(std::function<void(int level)> hook) { on_leave_ = std::move(hook); }
