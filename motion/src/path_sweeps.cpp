@@ -1,6 +1,8 @@
 #include "motion/path_sweeps.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace lbr::motion {
 
@@ -56,6 +58,9 @@ void SweepMapper::map(const nc::AxisVector& q0, const nc::AxisVector& q1, int to
 void path_sweeps(const ToolTable& tools, const kin::Kinematics& k, const nc::Toolpath& path,
                  const std::vector<double>* end_time, int channel, geom::MoveId id_base, std::vector<TimedSweep>& out,
                  std::uint64_t& moves) {
+  if (end_time != nullptr && end_time->size() != path.segments.size())
+    throw std::logic_error(path.source + ": " + std::to_string(end_time->size()) + " end times for " +
+                           std::to_string(path.segments.size()) + " segments");
   const SweepMapper mapper(tools, k);
   const bool direct = k.kind == nc::MachineKind::Mill3;
   geom::Pose pose = pose_of(path.start, path.start_axis);
@@ -94,6 +99,37 @@ void path_sweeps(const ToolTable& tools, const kin::Kinematics& k, const nc::Too
   }
 }
 
+namespace {
+
+// One end time per segment [s]. The planner's pieces are not one per segment (blend arcs,
+// merged naive-CAM runs), so the times come from an exact-stop plan of the same path, scaled
+// to the blended run's total time `total_s`: segments keep their order and the channel ends
+// when its blended run ends. In an exact-stop plan every piece is a Line ending at its
+// segment's end or a Hold; a motion too short to plan has no piece and ends when the
+// segment before it ends.
+std::vector<double> segment_end_times(const nc::Toolpath& path, const nc::EmulatorLimits& limits, double total_s) {
+  nc::Toolpath exact = path;
+  for (nc::Segment& s : exact.segments) s.path_control = nc::PathControl::ExactStop;
+  const nc::Emulator em(exact, limits);
+  const std::vector<nc::Emulator::Plan>& plans = em.plans();
+  const double scale = em.total_time_s() > 0.0 ? total_s / em.total_time_s() : 1.0;
+  std::vector<double> out;
+  out.reserve(path.segments.size());
+  std::size_t p = 0;
+  double t = 0.0;
+  for (const nc::Segment& s : path.segments) {
+    const bool hold = s.kind != nc::SegmentKind::Rapid && s.kind != nc::SegmentKind::Feed;
+    if (p < plans.size() && (plans[p].kind == nc::Emulator::PieceKind::Hold) == hold && plans[p].to == s.end) {
+      t = plans[p].t0_s + plans[p].duration_s;
+      ++p;
+    }
+    out.push_back(t * scale);
+  }
+  return out;
+}
+
+}  // namespace
+
 PlannedSweeps plan_channels(const ToolTable& tools, std::span<const ChannelPath> channels,
                             const nc::EmulatorLimits& limits, bool sampled) {
   PlannedSweeps out;
@@ -107,9 +143,7 @@ PlannedSweeps plan_channels(const ToolTable& tools, std::span<const ChannelPath>
       sampled_sweeps(tools, c, em, channel, id_base, out);
       id_base += static_cast<geom::MoveId>(em.sample_count());
     } else {
-      std::vector<double> end_time;
-      end_time.reserve(em.plans().size());
-      for (const auto& pl : em.plans()) end_time.push_back(pl.t0_s + pl.duration_s);
+      const std::vector<double> end_time = segment_end_times(c.path, limits, em.total_time_s());
       path_sweeps(tools, c.kin, c.path, &end_time, channel, id_base, out.sweeps, out.moves);
       id_base += static_cast<geom::MoveId>(c.path.segments.size());
     }
