@@ -57,6 +57,7 @@ class LevelCompare {
     for (int r = 0; r < solid_.regions(); ++r) {
       const geom::Rect rc = solid_.region_rect(r);
       const geom::Path rect{{rc.x0, rc.y0}, {rc.x1, rc.y0}, {rc.x1, rc.y1}, {rc.x0, rc.y1}};
+      stock_.clear();  // flatten() appends
       geom::flatten(solid_.cell(r, level), stock_);
       clip(ClipperLib::ctIntersection, design, geom::Paths{rect}, part_);
       clip(ClipperLib::ctDifference, part_, stock_, gouge_);
