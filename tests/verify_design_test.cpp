@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "app/batch.hpp"
+#include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "design_test_util.hpp"
 #include "nc/gcode.hpp"
@@ -143,4 +144,10 @@ TEST(DesignCompare, AnOverCutPassIsMeasuredAndLocated) {
   EXPECT_EQ(d.levels.size(), 50u);  // the 50 levels of the pocket's depth
   const std::string csv = verify::deviation_csv(d);
   EXPECT_EQ(csv.substr(0, csv.find('\n')), "level,z_mm,gouge_mm3,excess_mm3,max_gouge_mm,max_excess_mm");
+  app::Profile p = app::default_profile();
+  p.design = {stl, 0.02};
+  const std::string json = app::batch_metrics_json(r, p, "slot.ngc");
+  for (const char* key : {"\"design_gouge_mm3\": 150.", "\"design_excess_mm3\"", "\"max_gouge_mm\": 0.30",
+                          "\"max_gouge_line\": 20", "\"max_gouge_at_mm\""})
+    EXPECT_NE(json.find(key), std::string::npos) << key;
 }
