@@ -4,6 +4,7 @@
 #include "motion/path_sweeps.hpp"
 #include "motion/tool_table.hpp"
 #include "verify/collision.hpp"
+#include "verify/design.hpp"
 
 #include <sys/resource.h>
 
@@ -86,6 +87,22 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   if (progress) progress(1.0);
 }
 
+// --design: the model read, checked and sliced before the run, so its errors come first.
+std::vector<geom::Paths> design_sections(const Profile& profile, const geom::LbrSolid& solid) {
+  if (profile.design.stl_path.empty()) return {};
+  const verify::StlMesh mesh = verify::read_stl(profile.design.stl_path);
+  verify::check_design(mesh, solid, profile.design.stl_path);
+  return verify::slice_design(mesh, solid);
+}
+
+// --design: the final stock against the design, and the move that made the deepest gouge.
+void compare_design(const Profile& profile, const std::vector<geom::Paths>& design,
+                    const std::vector<motion::TimedSweep>& moves, const verify::MoveIndex& index, BatchResult& r) {
+  if (profile.design.stl_path.empty()) return;
+  r.design = verify::compare_design(design, r.solid, profile.design.tolerance_mm);
+  verify::attribute_gouge(*r.design, r.solid, moves, index);
+}
+
 }  // namespace
 
 std::vector<std::string> toolpath_warnings(const nc::Toolpath& path) {
@@ -132,15 +149,17 @@ geom::SolidSpec batch_solid_spec(const Profile& profile, const motion::ToolTable
 BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress) {
   motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   tools.require_path(path);
-  BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1, {}};
+  BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1, {}, {}};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
   r.machining_time_s = machining_time_s(profile, path);
   std::vector<motion::TimedSweep> moves;
   motion::path_sweeps(tools, profile.kin, path, nullptr, 0, 0, moves, r.moves);
   verify::MoveIndex index;
   index.add(path, 0);
+  const std::vector<geom::Paths> design = design_sections(profile, r.solid);
   verify::CollisionChecker checker(profile.checks, tools, index);
   run_moves(profile, moves, r, progress, profile.checks.enabled ? &checker : nullptr);
+  compare_design(profile, design, moves, index, r);
   return r;
 }
 
@@ -148,7 +167,7 @@ BatchResult run_batch_channels(const Profile& profile, const std::vector<Channel
                                const Progress& progress) {
   motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   for (const ChannelPath& c : channels) tools.require_path(c.path);
-  BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1, {}};
+  BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1, {}, {}};
   r.stock_volume_mm3 = r.solid.initial_volume_mm3();
   motion::PlannedSweeps plan = motion::plan_channels(tools, channels, emulator_limits(profile), sampled);
   r.machining_time_s = plan.machining_time_s;
@@ -159,8 +178,10 @@ BatchResult run_batch_channels(const Profile& profile, const std::vector<Channel
     if (!sampled) index.add(c.path, base);
     base += static_cast<geom::MoveId>(c.path.segments.size());
   }
+  const std::vector<geom::Paths> design = design_sections(profile, r.solid);
   verify::CollisionChecker checker(profile.checks, tools, index);
   run_moves(profile, plan.sweeps, r, progress, profile.checks.enabled ? &checker : nullptr);
+  compare_design(profile, design, plan.sweeps, index, r);
   return r;
 }
 

@@ -51,6 +51,8 @@ struct BatchOptions {
   bool no_tool = false;    // view: hide the tool
   std::string fail_on = "never";  // exit 3 when the checks raise events of this severity or worse
   bool no_checks = false;
+  std::string design;              // --design: STL of the part to compare the final stock with
+  double design_tolerance = 0.02;  // --tolerance [mm]
 };
 
 struct ViewCliOptions {
@@ -157,6 +159,18 @@ constexpr int kExitEvents = 3;
 // Events printed one per line; the rest are in events.csv.
 constexpr std::size_t kEventsShown = 20;
 
+// --design: one line with the comparison's figures.
+void report_design(const app::BatchResult& r, const BatchOptions& o) {
+  if (!r.design) return;
+  const verify::DesignReport& d = *r.design;
+  std::printf("design: gouge %.3f mm3, max %.3f mm", d.gouge_mm3, d.max_gouge_mm);
+  if (d.max_gouge_level >= 0)
+    std::printf(" at X%.3f Y%.3f Z%.3f (%s:%d)", d.max_gouge_at.x, d.max_gouge_at.y, d.max_gouge_at.z,
+                d.gouge_source.c_str(), d.gouge_line);
+  std::printf(" | excess %.3f mm3, max %.3f mm beyond %.3f mm (%s)\n", d.excess_mm3, d.max_excess_mm,
+              o.design_tolerance, out_file(o.out, "deviation.csv").c_str());
+}
+
 // The checks' summary line and the first events; returns kExitEvents when --fail-on says so.
 int report_events(const app::BatchResult& r, const BatchOptions& o) {
   const verify::EventCounts c = verify::count(r.events);
@@ -168,6 +182,7 @@ int report_events(const app::BatchResult& r, const BatchOptions& o) {
     else spdlog::warn("{}", verify::describe(e));
   }
   if (r.events.size() > kEventsShown) spdlog::warn("{} more events in {}", r.events.size() - kEventsShown, out_file(o.out, "events.csv"));
+  report_design(r, o);
   const bool fail = (o.fail_on == "error" && c.errors > 0) || (o.fail_on == "warning" && c.errors + c.warnings > 0);
   return fail ? kExitEvents : 0;
 }
@@ -218,6 +233,7 @@ app::Profile batch_profile(const BatchOptions& o) {
   apply_dialect(profile, o.dialect);
   if (o.start_tool >= 0) profile.nc.start_tool = o.start_tool;
   if (o.no_checks) profile.checks.enabled = false;
+  profile.design = {o.design, o.design_tolerance};
   return profile;
 }
 
@@ -640,6 +656,11 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
       ->check(CLI::IsMember({"never", "error", "warning"}))
       ->capture_default_str();
   batch->add_flag("--no-checks", b.no_checks, "Skip the collision and process checks (profile [checks] enabled = false)");
+  batch->add_option("--design", b.design, "Compare the final stock with this design model (STL, mm, work coordinates)")
+      ->check(CLI::ExistingFile);
+  batch->add_option("--tolerance", b.design_tolerance, "--design: stock closer than this outside the design is not excess [mm]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   return batch;
 }
 

@@ -82,6 +82,22 @@ nc::Toolpath demo_toolpath() { return nc::parse_movelist(kDemoProgram, "<built-i
 
 namespace {
 
+// --design: the comparison's keys of metrics.json (docs/formats.md#metrics-design).
+void design_json(const verify::DesignReport& d, const Profile& profile, nlohmann::json& j) {
+  j["design"] = profile.design.stl_path;
+  j["design_tolerance_mm"] = profile.design.tolerance_mm;
+  j["design_volume_mm3"] = d.design_volume_mm3;
+  j["design_gouge_mm3"] = d.gouge_mm3;
+  j["design_excess_mm3"] = d.excess_mm3;
+  j["max_gouge_mm"] = d.max_gouge_mm;
+  j["max_excess_mm"] = d.max_excess_mm;
+  if (d.max_gouge_level >= 0) j["max_gouge_at_mm"] = {d.max_gouge_at.x, d.max_gouge_at.y, d.max_gouge_at.z};
+  else j["max_gouge_at_mm"] = nullptr;
+  j["max_gouge_move"] = d.gouge_move;
+  j["max_gouge_source"] = d.gouge_source;
+  j["max_gouge_line"] = d.gouge_line;
+}
+
 // The events as metrics.json's "events" array (fields as the columns of events.csv).
 nlohmann::json events_json(const std::vector<verify::Event>& events) {
   nlohmann::json a = nlohmann::json::array();
@@ -142,6 +158,7 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
   j["event_errors"] = counts.errors;
   j["event_warnings"] = counts.warnings;
   j["events"] = events_json(r.events);
+  if (r.design) design_json(*r.design, profile, j);
   return j.dump(2) + "\n";
 }
 
@@ -183,6 +200,7 @@ void write_batch_outputs(const std::string& dir, const BatchResult& r, const Pro
   write_file(dir + "/metrics.json", batch_metrics_json(r, profile, program));
   write_file(dir + "/levels.lbrs", geom::to_bytes(r.solid));
   write_file(dir + "/events.csv", verify::events_csv(r.events));
+  if (r.design) write_file(dir + "/deviation.csv", verify::deviation_csv(*r.design));
 }
 
 }  // namespace lbr::app

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "motion/path_sweeps.hpp"
 #include "motion/tool_table.hpp"
 #include "nc/toolpath.hpp"
+#include "verify/design.hpp"
 #include "verify/events.hpp"
 
 namespace lbr::app {
@@ -26,6 +28,7 @@ struct BatchResult {
   geom::SubtractStats stats;
   int threads = 1;              // kernel worker threads used
   std::vector<verify::Event> events;  // collision and process checks (verify/), in move order
+  std::optional<verify::DesignReport> design;  // profile.design.stl_path set: the final stock against it
 };
 
 // Progress callback: fraction done in [0, 1].
@@ -38,7 +41,9 @@ using Progress = std::function<void(double)>;
 std::vector<std::string> toolpath_warnings(const nc::Toolpath& path);
 
 // Runs `path` on the stock of `profile`. Throws std::runtime_error naming the source line
-// when the path uses a tool the profile does not define. Segments with tool 0 (empty
+// when the path uses a tool the profile does not define, or (profile.design set) when the
+// design model cannot be read or compared (verify::StlError, verify::DesignError), before
+// the run. Segments with tool 0 (empty
 // spindle) remove nothing.
 [[nodiscard]] BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress = {});
 

@@ -21,6 +21,7 @@
 #include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
 #include "verify/collision.hpp"
+#include "verify/design.hpp"
 
 namespace lbr::app {
 
@@ -50,6 +51,7 @@ struct Profile {
   hal::LiveConfig live;        // [live], [[live.axis]], [threads]: `lbrsim run` (hal/config_toml.hpp)
   gfx::RenderThreadConfig render;  // [render]: the render thread's rate (gfx/config_toml.hpp)
   verify::CheckConfig checks;      // [checks]: collision and process checks (verify/config_toml.hpp)
+  verify::DesignConfig design;     // batch --design / --tolerance only (no profile key): design-model comparison
   std::vector<Channel> channels;   // [[channel]]; empty: one channel, the program given
 };
 
