@@ -261,10 +261,6 @@ double removed_by_sweeps_mm3(const geom::SolidSpec& spec, const app::PathStreame
   for (const motion::TimedSweep& t : s.sweeps()) {
     if (t.t_s > upto_s) break;
     batch.push_back(t.ref);
-    if (batch.size() == 4096) {
-      ref.subtract(batch);
-      batch.clear();
-    }
   }
   ref.subtract(batch);
   return ref.initial_volume_mm3() - ref.volume_mm3();

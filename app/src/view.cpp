@@ -145,23 +145,20 @@ double PathStreamer::take_seek() {
 
 bool PathStreamer::apply_due(double sim_s, std::size_t& next, geom::MoveId& last, std::vector<geom::SweepRef>& batch) {
   using clock = std::chrono::steady_clock;
-  bool any = false;
-  while (next < sweeps_.size() && sweeps_[next].t_s <= sim_s) {
-    batch.clear();
-    for (; next < sweeps_.size() && sweeps_[next].t_s <= sim_s && batch.size() < batch.capacity(); ++next) {
-      const motion::TimedSweep& s = sweeps_[next];
-      batch.push_back(s.ref);
-      ex_.add_path_point(s.ref.to.tip);
-      last = s.ref.id;
-      if (s.channel == 0 && s.line > 0) line_ = s.line;
-    }
-    const auto t0 = clock::now();
-    solid_.subtract(batch);
-    batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
-    batches_.fetch_add(1, std::memory_order_relaxed);
-    any = true;
+  batch.clear();
+  for (; next < sweeps_.size() && sweeps_[next].t_s <= sim_s; ++next) {
+    const motion::TimedSweep& s = sweeps_[next];
+    batch.push_back(s.ref);
+    ex_.add_path_point(s.ref.to.tip);
+    last = s.ref.id;
+    if (s.channel == 0 && s.line > 0) line_ = s.line;
   }
-  return any;
+  if (batch.empty()) return false;
+  const auto t0 = clock::now();
+  solid_.subtract(batch);
+  batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
+  batches_.fetch_add(1, std::memory_order_relaxed);
+  return true;
 }
 
 void PathStreamer::loop() {

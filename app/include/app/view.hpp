@@ -75,8 +75,8 @@ class PathStreamer {
   // A jump the operator asked for (ReplayControl::seek_*): the machining time to re-simulate
   // up to [s], or < 0 for none.
   double take_seek();
-  // Subtracts the sweeps due by `sim_s` from `next` on, in batches of at most the batch's
-  // capacity (no allocation); returns false when none was due.
+  // Subtracts the sweeps due by `sim_s` from `next` on as one batch (a jump: everything up to
+  // its target); returns false when none was due.
   bool apply_due(double sim_s, std::size_t& next, geom::MoveId& last, std::vector<geom::SweepRef>& batch);
   // Tools to draw: each channel's milling tool at the end of its latest sweep up to `upto`.
   std::size_t tools_at(std::size_t upto, std::array<gfx::ToolState, gfx::kMaxTools>& out) const;
