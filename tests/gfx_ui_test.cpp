@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <thread>
@@ -50,7 +51,7 @@ bool is_background(const std::uint8_t* p) {  // the clear colour (0.13, 0.14, 0.
 class UiWindow {
  public:
   UiWindow(const geom::LbrSolid& solid, gfx::StandardView view, gfx::ReplayControl* replay = nullptr, int width = kW,
-           int height = kH, bool kiosk = false) {
+           int height = kH, bool kiosk = false, std::vector<std::string> program = {}) {
     win_ = std::make_unique<gfx::Window>(width, height, true, "gfx_ui_test");
     gfx::RenderThreadConfig cfg;
     cfg.rate_hz = 20;
@@ -65,6 +66,7 @@ class UiWindow {
     cfg.ui.source = "gfx_ui_test";
     cfg.ui.replay = replay;
     cfg.ui.kiosk = kiosk;
+    cfg.ui.program = std::move(program);
     rt_ = std::make_unique<gfx::RenderThread>(*win_, ex_, solid, cfg);
     router_ = std::make_unique<gfx::EventRouter>(*rt_, height);
     rt_->start();
@@ -249,6 +251,80 @@ TEST_F(GfxUi, PauseStopsTheRemovedVolumeFromGrowing) {
   w.tap("Restart");
   ASSERT_TRUE(wait_for([&] { return !streamer.done(); }));  // cleared once the stock is back
   EXPECT_NEAR(solid.volume_mm3(), solid.initial_volume_mm3(), 1e-6 * solid.initial_volume_mm3());
+  streamer.stop();
+}
+
+// The same sweeps from the untouched stock up to `upto_s`, on a fresh solid [mm3 removed].
+double removed_by_sweeps_mm3(const geom::SolidSpec& spec, const app::PathStreamer& s, double upto_s) {
+  geom::LbrSolid ref(spec);
+  std::vector<geom::SweepRef> batch;
+  for (const motion::TimedSweep& t : s.sweeps()) {
+    if (t.t_s > upto_s) break;
+    batch.push_back(t.ref);
+  }
+  ref.subtract(batch);
+  return ref.initial_volume_mm3() - ref.volume_mm3();
+}
+
+// Program panel and time slider (issue 17) on cam-pocket.ngc, paused: touching the time
+// slider at 40 % re-simulates to about 40 % of the machining time (the removed volume is that
+// of the sweeps up to there), the panel scrolls to the line being cut and highlights it;
+// tapping a later line jumps to the end of that line's motion.
+TEST_F(GfxUi, TimeSliderAndProgramLinesJumpTheSimulation) {
+  const std::string prog = std::string(LBR_SOURCE_DIR) + "/config/programs/cam-pocket.ngc";
+  const app::Profile profile = app::load_profile(std::string(LBR_SOURCE_DIR) + "/config/profiles/default-mill3.toml");
+  const std::vector<app::ChannelPath> channels{{"", app::load_toolpath(prog, profile), profile.kin}};
+  std::vector<std::string> lines;
+  std::ifstream in(prog);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  const geom::SolidSpec spec = app::stream_solid_spec(profile, channels);
+  geom::LbrSolid solid(spec);
+  solid.clear_dirty();
+  gfx::ReplayControl ctl;
+  ctl.paused.store(true);
+  UiWindow w(solid, gfx::StandardView::Iso, &ctl, kW, kH, false, lines);
+  app::StreamOptions so;
+  so.control = &ctl;
+  app::PathStreamer streamer(profile, channels, solid, w.exchange(), so);
+  streamer.start();
+  const gfx::UiRect bar = w.item("##time");
+  w.tap(bar.x0 + 0.4 * (bar.x1 - bar.x0), 0.5 * (bar.y0 + bar.y1));
+  ASSERT_TRUE(wait_for([&] { return streamer.position_s() > 0; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the tick that published it ends
+  const double t = streamer.position_s();
+  EXPECT_NEAR(t / streamer.duration_s(), 0.4, 0.05);
+  const double removed_t = solid.initial_volume_mm3() - solid.volume_mm3();
+  EXPECT_GT(removed_t, 1000.0);
+  EXPECT_NEAR(removed_t, removed_by_sweeps_mm3(spec, streamer, t), 5e-5 * removed_t);
+  // The current line is shown, highlighted: its row differs from the row below.
+  const std::int64_t cur = streamer.program_line();
+  ASSERT_GT(cur, 0);
+  const gfx::UiRect row = w.item("##line " + std::to_string(cur));
+  const gfx::UiRect below = w.item("##line " + std::to_string(cur + 1));
+  const gfx::Image img = w.frame();
+  const int x = static_cast<int>(row.x1) - 6;
+  const std::uint8_t* a = img.px(x, static_cast<int>(0.5 * (row.y0 + row.y1)));
+  const std::uint8_t* b = img.px(x, static_cast<int>(0.5 * (below.y0 + below.y1)));
+  EXPECT_GT(std::abs(a[2] - b[2]), 20) << "the current line's row is not highlighted";
+  // Tap a later visible line with motion: the simulation ends that line's motion.
+  int target = 0;
+  for (const motion::TimedSweep& sw : streamer.sweeps()) {
+    gfx::UiRect r;
+    if (sw.line > cur + 1 && w.rt().ui_item("##line " + std::to_string(sw.line), r)) {
+      target = sw.line;
+      break;
+    }
+  }
+  ASSERT_GT(target, 0) << "no later line with motion is visible";
+  double end_s = 0;
+  for (const motion::TimedSweep& sw : streamer.sweeps())
+    if (sw.line == target) end_s = sw.t_s;
+  w.tap("##line " + std::to_string(target));
+  ASSERT_TRUE(wait_for([&] { return streamer.program_line() == target && streamer.position_s() == end_s; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const double removed_line = solid.initial_volume_mm3() - solid.volume_mm3();
+  EXPECT_GT(removed_line, removed_t);
+  EXPECT_NEAR(removed_line, removed_by_sweeps_mm3(spec, streamer, end_s), 5e-5 * removed_line);
   streamer.stop();
 }
 

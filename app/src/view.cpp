@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <stdexcept>
 
 #include <spdlog/spdlog.h>
@@ -119,6 +120,45 @@ void PathStreamer::restart(std::size_t& next, geom::MoveId& last) {
     for (int l = 0; l < solid_.levels(); ++l) solid_.set_cell(r, l, initial_->cell(r, l).polys, 0);
   next = 0;
   last = 0;
+  line_ = -1;
+}
+
+double PathStreamer::take_seek() {
+  gfx::ReplayControl* c = opt_.control;
+  if (c == nullptr) return -1.0;
+  const double t = c->seek_s.exchange(-1.0);
+  const long long line = c->seek_line.exchange(0);
+  if (line <= 0) return t;
+  // The end of the line's first run of motion (channel 0); a line without motion: just
+  // before the next line that moves.
+  std::size_t k = 0;
+  while (k < sweeps_.size() && (sweeps_[k].channel != 0 || sweeps_[k].line < line)) ++k;
+  double target = 0.0;
+  for (std::size_t j = 0; j < k; ++j) target = std::max(target, sweeps_[j].t_s);
+  for (; k < sweeps_.size(); ++k) {
+    if (sweeps_[k].channel != 0) continue;
+    if (sweeps_[k].line != line) break;
+    target = sweeps_[k].t_s;
+  }
+  return target;
+}
+
+bool PathStreamer::apply_due(double sim_s, std::size_t& next, geom::MoveId& last, std::vector<geom::SweepRef>& batch) {
+  using clock = std::chrono::steady_clock;
+  batch.clear();
+  for (; next < sweeps_.size() && sweeps_[next].t_s <= sim_s; ++next) {
+    const motion::TimedSweep& s = sweeps_[next];
+    batch.push_back(s.ref);
+    ex_.add_path_point(s.ref.to.tip);
+    last = s.ref.id;
+    if (s.channel == 0 && s.line > 0) line_ = s.line;
+  }
+  if (batch.empty()) return false;
+  const auto t0 = clock::now();
+  solid_.subtract(batch);
+  batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
+  batches_.fetch_add(1, std::memory_order_relaxed);
+  return true;
 }
 
 void PathStreamer::loop() {
@@ -137,38 +177,33 @@ void PathStreamer::loop() {
   geom::MoveId last = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
     const auto now = clock::now();
-    if (opt_.control != nullptr && opt_.control->restart.exchange(false)) {
+    const double seek = take_seek();
+    if (seek >= 0.0 || (opt_.control != nullptr && opt_.control->restart.exchange(false))) {
       restart(i, last);
-      // Just before the start: the samples at t = 0 run with the first tick that advances
-      // (a restart while paused must leave the stock untouched).
-      sim = -1e-9;
+      // A seek goes to its time; a restart to just before the start, so that the samples at
+      // t = 0 wait for the first tick that advances (a restart while paused leaves the stock
+      // untouched).
+      sim = seek >= 0.0 ? seek : -1e-9;
       tool_count = 0;
       done_.store(false, std::memory_order_release);
     }
-    sim = advance(sim, std::chrono::duration<double>(now - prev).count(), i);
+    if (seek < 0.0) sim = advance(sim, std::chrono::duration<double>(now - prev).count(), i);
     prev = now;
-    batch.clear();
-    for (; i < sweeps_.size() && sweeps_[i].t_s <= sim; ++i) {
-      batch.push_back(sweeps_[i].ref);
-      ex_.add_path_point(sweeps_[i].ref.to.tip);
-      last = sweeps_[i].ref.id;
-    }
     const double speed = opt_.control != nullptr ? opt_.control->speed.load(std::memory_order_relaxed) : opt_.speed;
-    if (!batch.empty()) {
-      const auto t0 = clock::now();
-      solid_.subtract(batch);
-      batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
-      batches_.fetch_add(1, std::memory_order_relaxed);
+    if (apply_due(sim, i, last, batch)) {
       tool_count = tools_at(i, tools);
       stats.lag_ms = std::max(0.0, (sim - sweeps_[i - 1].t_s) / speed * 1000.0);
       stats.sample_rate_hz = speed / opt_.sample_period_s;
       stats.samples = i;
     }
+    stats.program_line = line_;
     stats.machining_s = std::clamp(sim, 0.0, duration_s_);
     stats.paused = opt_.control != nullptr && opt_.control->paused.load(std::memory_order_relaxed);
     const std::span<const gfx::ToolState> shown(tools.data(), tool_count);
     // Publish every tick: a refused publish (render side busy) loses nothing.
     (void)ex_.publish(solid_, shown, last, stats);
+    line_pub_.store(line_, std::memory_order_relaxed);
+    position_s_.store(stats.machining_s, std::memory_order_release);
     if (i >= sweeps_.size()) {
       // Make sure the final state gets out.
       while (solid_.dirty_count() > 0 && !stop_.load(std::memory_order_relaxed)) {
@@ -205,6 +240,18 @@ std::unique_ptr<geom::LbrSolid> publish_batch_result(const Profile& profile, con
   return solid;
 }
 
+// The program's lines for the UI's program panel; empty when the source is no readable file
+// (the built-in demo).
+std::vector<std::string> program_text(const std::string& file) {
+  std::vector<std::string> lines;
+  std::ifstream in(file);
+  for (std::string l; std::getline(in, l);) {
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    lines.push_back(std::move(l));
+  }
+  return lines;
+}
+
 }  // namespace
 
 int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, const ViewOptions& opt) {
@@ -222,6 +269,7 @@ int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, c
   gfx::ReplayControl replay;
   replay.speed.store(opt.stream.speed);
   rc.ui.source = title;
+  if (channels.size() == 1) rc.ui.program = program_text(channels.front().path.source);
   if (opt.animate) {
     solid = std::make_unique<geom::LbrSolid>(stream_solid_spec(profile, channels));
     solid->clear_dirty();

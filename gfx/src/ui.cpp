@@ -47,6 +47,8 @@ Ui::Ui(const UiConfig& cfg) : cfg_(cfg) {
   st.WindowBorderSize = 0;
   st.Colors[ImGuiCol_WindowBg].w = 0.86f;
   lag_sorted_.reserve(lag_ms_.size());
+  line_labels_.reserve(cfg_.program.size());
+  for (std::size_t i = 0; i < cfg_.program.size(); ++i) line_labels_.push_back("##line " + std::to_string(i + 1));
   rects_.reserve(8);
   ImGui_ImplOpenGL3_Init("#version 330 core");
 }
@@ -95,7 +97,9 @@ UiActions Ui::frame(const Renderer& ren, const UiFrameInput& in) {
   act.opt = in.opt;
   status_bar(ren, in);
   view_panel(in, act);
-  if (cfg_.replay != nullptr) replay_bar();
+  replay_h_ = 0;
+  if (cfg_.replay != nullptr) replay_bar(ren);
+  if (!cfg_.program.empty()) program_panel(ren, in);
   quit_dialog(in, act);
   ImGui::Render();
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -348,7 +352,7 @@ void Ui::section_controls(UiActions& act) {
 
 // ---- replay bar (top left) -------------------------------------------------------------
 
-void Ui::replay_bar() {
+void Ui::replay_bar(const Renderer& ren) {
   ReplayControl& rc = *cfg_.replay;
   ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_Always);
   if (ImGui::Begin("##replay", nullptr, kFixed | ImGuiWindowFlags_AlwaysAutoResize)) {
@@ -369,7 +373,56 @@ void Ui::replay_bar() {
     if (ImGui::SliderFloat("##speed", &speed, 0.1f, 100.0f, "speed %.2fx", ImGuiSliderFlags_Logarithmic))
       rc.speed.store(speed);
     record("##speed");
+    time_slider(rc, ren.live());
     ImGui::PopStyleVar();
+    remember_window();
+    replay_h_ = ImGui::GetWindowSize().y;
+  }
+  ImGui::End();
+}
+
+// Machining time over the whole program; a release after dragging jumps there.
+void Ui::time_slider(ReplayControl& rc, const LiveStats& L) {
+  if (L.total_s <= 0) return;
+  const bool dragging = seek_s_ >= 0;
+  auto t = dragging ? seek_s_ : static_cast<float>(std::max(L.machining_s, 0.0));
+  ImGui::SetNextItemWidth(-1);
+  if (ImGui::SliderFloat("##time", &t, 0.0f, static_cast<float>(L.total_s), "t %.1f s")) seek_s_ = t;
+  record("##time");
+  if (ImGui::IsItemDeactivated()) {
+    if (seek_s_ >= 0) rc.seek_s.store(seek_s_);
+    seek_s_ = -1;
+  }
+}
+
+// ---- program panel (left, below the replay bar) ----------------------------------------
+
+void Ui::program_panel(const Renderer& ren, const UiFrameInput& in) {
+  const float fs = ImGui::GetFontSize();
+  const float top = replay_h_;
+  const float h = std::max(4 * fs, (static_cast<float>(in.height) - status_h_ - top) * 0.5f);
+  ImGui::SetNextWindowPos(ImVec2(0, top), ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(fs * 22, h), ImGuiCond_Always);
+  if (ImGui::Begin("##program", nullptr, kFixed)) {
+    const std::int64_t cur = ren.live().program_line;
+    const float row = ImGui::GetTextLineHeightWithSpacing();
+    if (cur > 0 && cur != scrolled_line_) {  // keep the current line in the middle
+      ImGui::SetScrollY(std::max(0.0f, static_cast<float>(cur - 1) * row - 0.5f * ImGui::GetWindowHeight()));
+      scrolled_line_ = cur;
+    }
+    ImGuiListClipper clip;
+    clip.Begin(static_cast<int>(cfg_.program.size()), row);
+    while (clip.Step()) {
+      for (int i = clip.DisplayStart; i < clip.DisplayEnd; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        char text[256];
+        std::snprintf(text, sizeof text, "%5d  %s", i + 1, cfg_.program[k].c_str());
+        ImGui::PushID(i);
+        if (ImGui::Selectable(text, cur == i + 1) && cfg_.replay != nullptr) cfg_.replay->seek_line.store(i + 1);
+        record(line_labels_[k].c_str());
+        ImGui::PopID();
+      }
+    }
     remember_window();
   }
   ImGui::End();

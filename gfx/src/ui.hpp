@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -75,7 +76,9 @@ class Ui {
   void view_buttons(UiActions& act);
   void display_toggles(UiActions& act);
   void section_controls(UiActions& act);
-  void replay_bar();
+  void replay_bar(const Renderer& ren);
+  void time_slider(ReplayControl& rc, const LiveStats& L);
+  void program_panel(const Renderer& ren, const UiFrameInput& in);
   void quit_dialog(const UiFrameInput& in, UiActions& act);
   void remember_window();
   bool button(const char* label, const ImVec2& size);
@@ -98,6 +101,12 @@ class Ui {
   std::vector<double> lag_sorted_;
   std::uint64_t last_version_ = 0;
   double since_data_s_ = 0;    // time since the last new snapshot [s]
+  // Program panel: a label per line ("##line N", the rows' item names) and the line the
+  // panel last scrolled to.
+  std::vector<std::string> line_labels_;
+  std::int64_t scrolled_line_ = -1;
+  float replay_h_ = 0;         // height of the replay bar last frame [px]
+  float seek_s_ = -1;          // the time slider's value while the operator drags it [s]
 };
 
 }  // namespace lbr::gfx::detail

@@ -57,6 +57,12 @@ class PathStreamer {
   [[nodiscard]] bool done() const noexcept { return done_.load(std::memory_order_acquire); }
   [[nodiscard]] double duration_s() const noexcept { return duration_s_; }  // simulated machining time
   [[nodiscard]] std::uint64_t batches() const noexcept { return batches_.load(std::memory_order_relaxed); }
+  // Where the stream stands after its latest tick: simulated machining time [s] and the
+  // source line of channel 0's newest applied sweep (-1: none yet), as published in LiveStats.
+  [[nodiscard]] double position_s() const noexcept { return position_s_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::int64_t program_line() const noexcept { return line_pub_.load(std::memory_order_acquire); }
+  // The planned sweeps, in time order, each with its source line (tests, tools).
+  [[nodiscard]] const std::vector<motion::TimedSweep>& sweeps() const noexcept { return sweeps_; }
   // Wall time of each subtract() batch [ms] (valid after stop()/done()).
   [[nodiscard]] const std::vector<double>& batch_ms() const noexcept { return batch_ms_; }
 
@@ -66,6 +72,12 @@ class PathStreamer {
   double advance(double sim_s, double dt_s, std::size_t next);
   // Back to the untouched stock; every cell is republished.
   void restart(std::size_t& next, geom::MoveId& last);
+  // A jump the operator asked for (ReplayControl::seek_*): the machining time to re-simulate
+  // up to [s], or < 0 for none.
+  double take_seek();
+  // Subtracts the sweeps due by `sim_s` from `next` on as one batch (a jump: everything up to
+  // its target); returns false when none was due.
+  bool apply_due(double sim_s, std::size_t& next, geom::MoveId& last, std::vector<geom::SweepRef>& batch);
   // Tools to draw: each channel's milling tool at the end of its latest sweep up to `upto`.
   std::size_t tools_at(std::size_t upto, std::array<gfx::ToolState, gfx::kMaxTools>& out) const;
 
@@ -80,6 +92,9 @@ class PathStreamer {
   std::atomic<bool> stop_{false}, done_{false};
   std::atomic<std::uint64_t> batches_{0};
   std::vector<double> batch_ms_;
+  std::int64_t line_ = -1;  // source line of channel 0's newest applied sweep
+  std::atomic<double> position_s_{0.0};
+  std::atomic<std::int64_t> line_pub_{-1};
 };
 
 // The stock `lbrsim batch` would use for these channels (regions = auto sized like batch).

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <string>
+#include <vector>
 
 namespace lbr::gfx {
 
@@ -16,6 +17,10 @@ struct ReplayControl {
   std::atomic<double> speed{1.0};       // simulated seconds per wall second
   std::atomic<int> steps{0};            // single steps asked for while paused (source consumes)
   std::atomic<bool> restart{false};     // start again from the untouched stock (source clears it)
+  // Jumps (the source clears them): re-simulate from the untouched stock up to machining
+  // time seek_s [s] (>= 0), or to the end of program line seek_line's motion (> 0).
+  std::atomic<double> seek_s{-1.0};
+  std::atomic<long long> seek_line{0};
 };
 
 struct UiConfig {
@@ -24,6 +29,9 @@ struct UiConfig {
   bool kiosk = false;          // quitting needs a confirmation in the UI
   std::string source;          // what feeds the view (program, device), for the status bar
   ReplayControl* replay = nullptr;  // non-null: the replay bar is shown
+  // The program's text, one entry per source line (line 1 first), for the program panel;
+  // empty: no panel. With `replay`, tapping a line jumps there (ReplayControl::seek_line).
+  std::vector<std::string> program;
 };
 
 // A pointer event in window pixels (origin top-left), from the main thread's GLFW callbacks.

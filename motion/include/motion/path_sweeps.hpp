@@ -24,6 +24,7 @@ struct TimedSweep {
   int channel = 0;
   int tool = 0;
   geom::SweepRef ref;
+  int line = 0;  // 1-based source line of the motion it belongs to (0: unknown)
 };
 
 // Maps one motion of a channel (axes q0 → q1 with `tool`) through the kinematics into
