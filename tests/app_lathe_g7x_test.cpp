@@ -5,6 +5,8 @@
 // installed. The cycles' own moves are checked pass by pass on a hand-computed case.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -35,7 +37,9 @@ app::Profile sharp_lathe() {
 }
 
 double removed_mm3(const std::string& program, app::Interpreter interp) {
-  const std::string path = ::testing::TempDir() + "g7x_test.ngc";
+  // One file per test and process: ctest runs the cases in parallel processes.
+  const ::testing::TestInfo* t = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string path = ::testing::TempDir() + "g7x_" + t->name() + "_" + std::to_string(::getpid()) + ".ngc";
   std::ofstream(path) << program;
   const app::Profile profile = sharp_lathe();
   return app::run_batch(profile, app::load_toolpath(path, profile, interp)).removed_volume_mm3;
