@@ -307,16 +307,7 @@ TEST(FanucDialect, SeededMutatorNeverCrashesOrHangs) {
   for (; runs < 20000; ++runs) {
     if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(3)) break;
     std::string s = corpus[rng() % corpus.size()];
-    const int edits = 1 + static_cast<int>(rng() % 6);
-    for (int e = 0; e < edits && !s.empty(); ++e) {
-      const std::size_t pos = rng() % s.size();
-      switch (rng() % 4) {
-        case 0: s.erase(pos, 1 + rng() % 3); break;
-        case 1: s.insert(pos, 1, alphabet[rng() % alphabet.size()]); break;
-        case 2: s[pos] = alphabet[rng() % alphabet.size()]; break;
-        default: s.insert(pos, s.substr(rng() % s.size(), rng() % 12)); break;
-      }
-    }
+    lbr::test::mutate(s, rng, alphabet);
     const long lines = 1 + std::count(s.begin(), s.end(), '\n');
     try {
       const Toolpath tp = interpret_gcode(s, "fuzz.nc", o);

@@ -18,16 +18,9 @@ namespace {
 
 using namespace lbr::nc;
 
+using lbr::test::ends;
 using lbr::test::error_of;
 using lbr::test::run;
-
-// Feed/rapid end points only (no dwell or tool change).
-std::vector<AxisVector> ends(const Toolpath& tp) {
-  std::vector<AxisVector> v;
-  for (const Segment& s : tp.segments)
-    if (s.kind == SegmentKind::Rapid || s.kind == SegmentKind::Feed) v.push_back(s.end);
-  return v;
-}
 
 // Temporary directory for program and subroutine files.
 class NgcFiles : public ::testing::Test {

@@ -23,16 +23,9 @@ namespace {
 
 using namespace lbr::nc;
 
+using lbr::test::ends;
 using lbr::test::error_of;
 using lbr::test::run;
-
-// Rapid/feed end points (dwells and tool changes left out).
-std::vector<AxisVector> ends(const Toolpath& tp) {
-  std::vector<AxisVector> v;
-  for (const Segment& s : tp.segments)
-    if (s.kind == SegmentKind::Rapid || s.kind == SegmentKind::Feed) v.push_back(s.end);
-  return v;
-}
 
 GcodeOptions lathe() {
   GcodeOptions o;

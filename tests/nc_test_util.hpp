@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "nc/gcode.hpp"
 #include "nc/toolpath.hpp"
@@ -15,6 +16,30 @@
 #endif
 
 namespace lbr::test {
+
+// Rapid/feed end points of a tool path (dwells and tool changes left out).
+inline std::vector<nc::AxisVector> ends(const nc::Toolpath& tp) {
+  std::vector<nc::AxisVector> v;
+  for (const nc::Segment& s : tp.segments)
+    if (s.kind == nc::SegmentKind::Rapid || s.kind == nc::SegmentKind::Feed) v.push_back(s.end);
+  return v;
+}
+
+// One mutation of the interpreters' seeded mutation tests: 1–6 random edits of `s` (delete,
+// insert or replace a character of `alphabet`, or duplicate a piece of s).
+template <class Rng>
+void mutate(std::string& s, Rng& rng, const std::string& alphabet) {
+  const int edits = 1 + static_cast<int>(rng() % 6);
+  for (int e = 0; e < edits && !s.empty(); ++e) {
+    const std::size_t pos = rng() % s.size();
+    switch (rng() % 4) {
+      case 0: s.erase(pos, 1 + rng() % 3); break;
+      case 1: s.insert(pos, 1, alphabet[rng() % alphabet.size()]); break;
+      case 2: s[pos] = alphabet[rng() % alphabet.size()]; break;
+      default: s.insert(pos, s.substr(rng() % s.size(), rng() % 12)); break;
+    }
+  }
+}
 
 // A bundled part program (config/programs/NAME).
 inline std::string program_file(const std::string& name) { return std::string(LBR_SOURCE_DIR) + "/config/programs/" + name; }

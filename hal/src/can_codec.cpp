@@ -155,81 +155,64 @@ void CanopenAssembler::close_cycle(Counters& c) noexcept {
   }
 }
 
-int CanopenAssembler::on_frame(const CanFrame& f, std::int64_t now_mono_ns, std::span<AxisSample, kMaxChannels> out,
-                               Counters& c) noexcept {
-  if (f.err) {
-    c.add(Fault::ErrorFrame);
-    return 0;
-  }
-  if (f.ext || f.rtr) {
-    c.add(Fault::UnknownId);
-    return 0;
-  }
-  if (f.id == cfg_.can.sync_id) {
-    if (f.len > 1) {
-      c.add(Fault::LengthError);
-      return 0;
-    }
-    close_cycle(c);
-    ++syncs_;
-    std::uint64_t step = 1;
-    if (f.len == 1) {
-      const int counter = f.data[0];
-      const int max = cfg_.can.sync_counter_max;
-      if (last_counter_ >= 0) {
-        const int expected = last_counter_ % max + 1;
-        auto gap = static_cast<std::uint64_t>(((counter - expected) % max + max) % max);
-        gap += hidden_turns(f.t_ns, gap);
-        if (gap > 0) {
-          c.add(Fault::SeqGap, gap);
-          lost_ += gap;
-          step += gap;
-        }
+// A SYNC frame: closes the open cycle (counting its missing TPDOs) and opens the next; a
+// jump of the SYNC counter counts the cycles it skipped as lost.
+void CanopenAssembler::on_sync(const CanFrame& f, Counters& c) noexcept {
+  close_cycle(c);
+  ++syncs_;
+  std::uint64_t step = 1;
+  if (f.len == 1) {
+    const int counter = f.data[0];
+    const int max = cfg_.can.sync_counter_max;
+    if (last_counter_ >= 0) {
+      const int expected = last_counter_ % max + 1;
+      auto gap = static_cast<std::uint64_t>(((counter - expected) % max + max) % max);
+      gap += hidden_turns(f.t_ns, gap);
+      if (gap > 0) {
+        c.add(Fault::SeqGap, gap);
+        lost_ += gap;
+        step += gap;
       }
-      last_counter_ = counter;
-      last_sync_t_ = f.t_ns;
     }
-    seq_ += step;
-    open_ = true;
-    completed_ = false;
-    sync_t_ = f.t_ns;
-    answered_.fill(false);
-    answered_count_ = 0;
-    return 0;
+    last_counter_ = counter;
+    last_sync_t_ = f.t_ns;
   }
-  const std::uint32_t node = f.id - cfg_.can.tpdo_base;
+  seq_ += step;
+  open_ = true;
+  completed_ = false;
+  sync_t_ = f.t_ns;
+  answered_.fill(false);
+  answered_count_ = 0;
+}
+
+// A TPDO of a mapped node: the fault it is, or none when it belongs to the open cycle.
+bool CanopenAssembler::accept_tpdo(const CanFrame& f, std::uint32_t node, Counters& c) const noexcept {
   if (f.id < cfg_.can.tpdo_base || node > 127 || node_map_[node] < 0) {
     c.add(Fault::UnknownId);
-    return 0;
+    return false;
   }
   if (f.len != 4 && f.len != 6) {
     c.add(Fault::LengthError);
-    return 0;
+    return false;
   }
   if (!open_) {
     c.add(Fault::LateTpdo);
-    return 0;
+    return false;
   }
   if (answered_[node]) {
     c.add(Fault::DuplicateTpdo);
-    return 0;
+    return false;
   }
   if (completed_ || f.t_ns - sync_t_ > late_ns_) {
     c.add(Fault::LateTpdo);
-    return 0;
+    return false;
   }
-  const auto raw = static_cast<std::int32_t>(static_cast<std::uint32_t>(f.data[0]) | static_cast<std::uint32_t>(f.data[1]) << 8 |
-                                             static_cast<std::uint32_t>(f.data[2]) << 16 |
-                                             static_cast<std::uint32_t>(f.data[3]) << 24);
-  if (f.len == 6) {
-    const auto status = static_cast<std::uint16_t>(f.data[4] | f.data[5] << 8);
-    if (status & 0x0008U) c.add(Fault::DriveFault);
-  }
-  answered_[node] = true;
-  raw_[node] = raw;
-  if (++answered_count_ < mapped_) return 0;
+  return true;
+}
 
-  // Complete: one sample per channel.
+// Every mapped node answered: one sample per channel into `out`; returns how many.
+int CanopenAssembler::complete_cycle(std::int64_t now_mono_ns, std::span<AxisSample, kMaxChannels> out,
+                                     Counters& c) noexcept {
   completed_ = true;
   std::array<bool, kMaxChannels> used{};
   for (auto& s : out) s = AxisSample{};
@@ -255,6 +238,36 @@ int CanopenAssembler::on_frame(const CanFrame& f, std::int64_t now_mono_ns, std:
   }
   ++samples_;
   return n;
+}
+
+int CanopenAssembler::on_frame(const CanFrame& f, std::int64_t now_mono_ns, std::span<AxisSample, kMaxChannels> out,
+                               Counters& c) noexcept {
+  if (f.err) {
+    c.add(Fault::ErrorFrame);
+    return 0;
+  }
+  if (f.ext || f.rtr) {
+    c.add(Fault::UnknownId);
+    return 0;
+  }
+  if (f.id == cfg_.can.sync_id) {
+    if (f.len > 1) c.add(Fault::LengthError);
+    else on_sync(f, c);
+    return 0;
+  }
+  const std::uint32_t node = f.id - cfg_.can.tpdo_base;
+  if (!accept_tpdo(f, node, c)) return 0;
+  const auto raw = static_cast<std::int32_t>(static_cast<std::uint32_t>(f.data[0]) | static_cast<std::uint32_t>(f.data[1]) << 8 |
+                                             static_cast<std::uint32_t>(f.data[2]) << 16 |
+                                             static_cast<std::uint32_t>(f.data[3]) << 24);
+  if (f.len == 6) {
+    const auto status = static_cast<std::uint16_t>(f.data[4] | f.data[5] << 8);
+    if (status & 0x0008U) c.add(Fault::DriveFault);
+  }
+  answered_[node] = true;
+  raw_[node] = raw;
+  if (++answered_count_ < mapped_) return 0;
+  return complete_cycle(now_mono_ns, out, c);
 }
 
 }  // namespace lbr::hal

@@ -57,6 +57,9 @@ class CanopenAssembler {
 
  private:
   void close_cycle(Counters& c) noexcept;
+  void on_sync(const CanFrame& f, Counters& c) noexcept;
+  [[nodiscard]] bool accept_tpdo(const CanFrame& f, std::uint32_t node, Counters& c) const noexcept;
+  int complete_cycle(std::int64_t now_mono_ns, std::span<AxisSample, kMaxChannels> out, Counters& c) noexcept;
   [[nodiscard]] std::uint64_t hidden_turns(std::int64_t t_ns, std::uint64_t gap) const noexcept;
 
   LiveConfig cfg_;
