@@ -123,6 +123,14 @@ nlohmann::json events_json(const std::vector<verify::Event>& events) {
 
 }  // namespace
 
+void put_events_json(const std::vector<verify::Event>& events, bool checks, nlohmann::json& j) {
+  j["checks"] = checks;
+  const verify::EventCounts counts = verify::count(events);
+  j["event_errors"] = counts.errors;
+  j["event_warnings"] = counts.warnings;
+  j["events"] = events_json(events);
+}
+
 std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program) {
   nlohmann::json j;
   j["lbrsim_version"] = version();

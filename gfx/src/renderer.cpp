@@ -644,6 +644,26 @@ void Renderer::draw_hud(int w, int h) {
     std::snprintf(buf + used, sizeof buf - used, "WARNING: %s\n", opt_.notice.c_str());
   }
   gl_->hud->draw(buf, w, h);
+  draw_alarms(w, h);
+}
+
+// The live alarms (collision events) on a red band across the bottom, as the operator UI's
+// status bar shows them (docs/ui.md).
+void Renderer::draw_alarms(int w, int h) {
+  const LiveStats& L = live_;
+  const int n = std::min(L.alarm_count, kMaxAlarms);
+  if (n <= 0) return;
+  char buf[kMaxAlarms * (kAlarmTextChars + 16)];
+  std::size_t used = 0;
+  buf[0] = '\0';
+  for (int i = 0; i < n; ++i) {
+    const Alarm& a = L.alarms[static_cast<std::size_t>(i)];
+    const char* tag = a.severity == AlarmSeverity::Error ? "ALARM" : (a.severity == AlarmSeverity::Warning ? "WARNING" : "INFO");
+    const int k = std::snprintf(buf + used, sizeof buf - used, "%s%s: %s", i > 0 ? "\n" : "", tag, a.text.data());
+    if (k < 0 || static_cast<std::size_t>(k) >= sizeof buf - used) break;
+    used += static_cast<std::size_t>(k);
+  }
+  gl_->hud->draw_alarm_band(buf, w, h);
 }
 
 FrameInfo Renderer::frame_offscreen(const Camera& cam, int w, int h) {

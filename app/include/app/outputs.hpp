@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "app/batch.hpp"
 #include "app/profile.hpp"
 #include "nc/toolpath.hpp"
@@ -35,6 +37,9 @@ std::uint64_t write_samples_csv(const std::string& path, nc::Emulator& emulator)
 // The bundled demo part program (config/programs/demo-pocket.moves, compiled in).
 [[nodiscard]] nc::Toolpath demo_toolpath();
 
+// The checks' keys of metrics.json (docs/formats.md#events): checks, event_errors,
+// event_warnings and the "events" array (fields as the columns of events.csv).
+void put_events_json(const std::vector<verify::Event>& events, bool checks, nlohmann::json& j);
 // Metrics of a batch run as a JSON document (keys in docs/formats.md#metrics).
 [[nodiscard]] std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program);
 

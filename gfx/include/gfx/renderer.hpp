@@ -120,6 +120,7 @@ class Renderer {
   void draw_path();
   void draw_outline();
   void draw_hud(int w, int h);
+  void draw_alarms(int w, int h);
 
   RenderOptions opt_;
   MeshMirror mirror_;
