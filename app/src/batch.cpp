@@ -101,6 +101,7 @@ void compare_design(const Profile& profile, const std::vector<geom::Paths>& desi
   if (profile.design.stl_path.empty()) return;
   r.design = verify::compare_design(design, r.solid, profile.design.tolerance_mm);
   verify::attribute_gouge(*r.design, r.solid, moves, index);
+  r.design_sections = design;
 }
 
 }  // namespace

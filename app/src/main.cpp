@@ -144,12 +144,17 @@ gfx::CaptureOptions capture_options(const BatchOptions& o) {
   return cap;
 }
 
-void write_png_if_asked(const geom::LbrSolid& solid, const BatchOptions& o, const gfx::CaptureOptions& cap,
+// --color deviation: colours from the design the run compared with (docs/verification.md#deviation-colour).
+bool deviation_colours(const BatchOptions& o) { return o.color == "deviation"; }
+
+void write_png_if_asked(const app::BatchResult& r, const BatchOptions& o, const gfx::CaptureOptions& cap,
                         const std::vector<gfx::ToolState>& tools) {
   if (o.png.empty()) return;
+  gfx::CaptureOptions c = cap;
+  if (deviation_colours(o)) c.deviation = app::deviation_fn(r.design_sections, r.solid, o.design_tolerance);
   // A picture of the finished part: the tool would hide part of it (issue 19), so it is
   // drawn only with --show-tool.
-  gfx::capture_png(solid, o.png, cap, o.show_tool && !o.no_tool ? tools : std::vector<gfx::ToolState>{});
+  gfx::capture_png(r.solid, o.png, c, o.show_tool && !o.no_tool ? tools : std::vector<gfx::ToolState>{});
   std::printf("wrote %s (%dx%d, view %s, colour %s)\n", o.png.c_str(), cap.width, cap.height, o.view.c_str(),
               o.color.c_str());
 }
@@ -195,7 +200,9 @@ void print_result(const app::BatchResult& r, const BatchOptions& o) {
               r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
   std::printf("wrote %s, %s and %s\n", out_file(o.out, "metrics.json").c_str(), out_file(o.out, "levels.lbrs").c_str(),
               out_file(o.out, "events.csv").c_str());
-  app::write_mesh_files(r.solid, o.stl, o.ply);
+  app::DeviationColours colours;
+  if (deviation_colours(o)) colours = {&r.design_sections, o.design_tolerance};
+  app::write_mesh_files(r.solid, o.stl, o.ply, colours);
   if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
   if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
 }
@@ -219,7 +226,7 @@ int run_channels_command(const BatchOptions& o, const app::Profile& profile, con
   std::printf("%zu channels (%s)%s\n", channels.size(), names.c_str(), o.sampled ? ", sampled" : "");
   print_result(r, o);
   const int status = report_events(r, o);
-  write_png_if_asked(r.solid, o, cap, {});
+  write_png_if_asked(r, o, cap, {});
   return status;
 }
 
@@ -283,6 +290,8 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
 
 int run_batch_command(const BatchOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::warn);  // --quiet: the result lines and warnings only
+  if (deviation_colours(o) && o.design.empty())
+    throw std::runtime_error("--color deviation needs --design FILE.stl: the design model whose deviation it shows");
   const app::Profile profile = batch_profile(o);
   const gfx::CaptureOptions cap = capture_options(o);
   if (!profile.channels.empty()) return run_channels_command(o, profile, cap);
@@ -312,7 +321,7 @@ int run_batch_command(const BatchOptions& o) {
   app::write_batch_outputs(o.out, r, profile, program);
   print_result(r, o);
   const int status = report_events(r, o);
-  write_png_if_asked(r.solid, o, cap, app::final_tools(profile, path));
+  write_png_if_asked(r, o, cap, app::final_tools(profile, path));
   if (o.view_window) return run_view_command(o, ViewCliOptions{});
   return status;
 }
@@ -610,8 +619,10 @@ void add_render_options(CLI::App* c, BatchOptions& o) {
   c->add_option("--view", o.view, "Camera: top, front, side or iso")
       ->check(CLI::IsMember({"top", "front", "side", "iso"}))
       ->capture_default_str();
-  c->add_option("--color", o.color, "Colour mode: plain, heat (move of the last cut) or regions (grid)")
-      ->check(CLI::IsMember({"plain", "heat", "regions"}))
+  c->add_option("--color", o.color,
+                "Colour mode: plain, heat (move of the last cut), regions (grid) or deviation (from --design: "
+                "gouge red, excess blue)")
+      ->check(CLI::IsMember({"plain", "heat", "regions", "deviation"}))
       ->capture_default_str();
   c->add_option("--size", o.size, "Image / window size WxH [px]")->capture_default_str();
 }

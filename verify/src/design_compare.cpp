@@ -181,6 +181,57 @@ void attribute_gouge(DesignReport& report, const geom::LbrSolid& solid, std::spa
   }
 }
 
+namespace {
+
+// Where point p lies against the design: 1 inside the section of its level, 0 outside
+// (above or below the stock too), -1 on a section's boundary.
+int design_side(const std::vector<geom::Paths>& design, const geom::LbrSolid& solid, const geom::Vec3& p) {
+  if (p.z < solid.z_bottom_mm() || p.z > solid.z_top_mm()) return 0;
+  const geom::Paths& d = design[static_cast<std::size_t>(solid.level_at(p.z))];
+  const geom::Point q{geom::to_units(p.x), geom::to_units(p.y)};
+  int inside = 0;
+  for (const geom::Path& path : d) {
+    const int k = ClipperLib::PointInPolygon(q, path);
+    if (k < 0) return -1;
+    inside += k;
+  }
+  return inside % 2;  // the NonZero union's outer contours and holes
+}
+
+}  // namespace
+
+void vertex_deviation(const std::vector<geom::Paths>& design, const geom::LbrSolid& solid,
+                      std::span<const float> positions, std::span<const float> normals, double tolerance_mm,
+                      std::vector<float>& out) {
+  out.assign(positions.size() / 3, 0.0f);
+  if (design.size() != static_cast<std::size_t>(solid.levels())) return;
+  const double half = 0.5 * tolerance_mm;
+  // The in-plane depth of `at` inside (gouge) or outside (excess) the design section [mm].
+  const auto depth_mm = [&](const geom::Vec3& at) {
+    const geom::Paths& d = design[static_cast<std::size_t>(solid.level_at(at.z))];
+    return d.empty() ? 1e9 : nearest_boundary(d, {geom::to_units(at.x), geom::to_units(at.y)}).dist_units * geom::kMmPerUnit;
+  };
+  // A point on a level boundary (cap edges, probes moved sideways from them) belongs to both
+  // levels: `side` must hold on both (1 µm below and above).
+  const auto both = [&](const geom::Vec3& at, int side) {
+    const geom::Vec3 dz{0, 0, 1e-3};
+    return design_side(design, solid, at - dz) == side && design_side(design, solid, at + dz) == side;
+  };
+  for (std::size_t v = 0; v < out.size(); ++v) {
+    const geom::Vec3 p{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]};
+    const geom::Vec3 n{normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]};
+    const geom::Vec3 outside = p + half * n, inside = p - half * n;
+    // Gouge: half the tolerance outside the stock is design material, at least half the
+    // tolerance deep; excess: half the tolerance inside is as far outside the design. A
+    // vertex where a floor meets a wall sits on both within rounding and is neither.
+    if (both(outside, 1)) {
+      if (const double d = depth_mm(outside); d >= half) out[v] = static_cast<float>(-(d + half));
+    } else if (both(inside, 0)) {
+      if (const double d = depth_mm(inside); d >= half) out[v] = static_cast<float>(std::min(d, 1e6) + half);
+    }
+  }
+}
+
 std::string deviation_csv(const DesignReport& report) {
   std::ostringstream o;
   o << "level,z_mm,gouge_mm3,excess_mm3,max_gouge_mm,max_excess_mm\n";
