@@ -318,7 +318,7 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
     }
     return emit(sc.hull, out, sc.spare);
   }
-  ramp_hull(sc, n, grow, uc);
+  ramp_hull(sc, n, grow, uc, false);
   // Capsule: the disk farthest along the motion and the largest one (or the first).
   {
     const auto& ds = sc.disks;  // sorted by s, radii are circumradii now
@@ -343,7 +343,7 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
 // then for each grid direction k walk the envelope from h(-π/n) to h(+π/n) and emit vertex k
 // of each winner. As θ grows the support point runs over the hull's vertices
 // counter-clockwise, so the output is the hull in order, in O(n + disks).
-void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<P2>& uc) const {
+void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<P2>& uc, bool ends_only) const {
   double ex = to_.tip.x - from_.tip.x, ey = to_.tip.y - from_.tip.y;
   const double len = std::hypot(ex, ey);
   if (len > 0.0) {
@@ -411,6 +411,7 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
   sc.hull.clear();
   sc.hull_role.clear();
   sc.hull_grid.clear();
+  int run_piece = -1, run_len = 0;
   for (int k = 0; k < n; ++k) {
     const double ck = uc[k].x, sk = uc[k].y;
     const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
@@ -426,6 +427,17 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
       i0 = piece(hp);
       i1 = piece(hm);
     }
+    // ends_only: a run of directions that one end disk wins whole keeps its first and last
+    // vertex (the caps' grid interval is all section_caps() needs of it).
+    const bool whole = i0 == i1 && disks[env[i0]].role != 0;
+    if (ends_only && whole && i0 == run_piece && run_len >= 2) {
+      const auto& d = disks[env[i0]];
+      sc.hull.back() = {d.x + d.r * ck, d.y + d.r * sk};
+      sc.hull_grid.back() = k;
+      continue;
+    }
+    run_len = !whole ? 0 : i0 == run_piece ? run_len + 1 : 1;
+    run_piece = whole ? i0 : -1;
     const int step = i1 >= i0 ? 1 : -1;
     for (int i = i0;; i += step) {
       const auto& d = disks[env[i]];
@@ -465,7 +477,7 @@ bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) co
     out.front_l = out.back_l = nearest(th + 0.5 * std::numbers::pi);
     return true;
   }
-  ramp_hull(sc, n, grow, sc.unit_circle(n));
+  ramp_hull(sc, n, grow, sc.unit_circle(n), true);
   // The caps are the hull's runs of start-disk and end-disk vertices; each must be one run.
   const std::size_t m = sc.hull.size();
   // One pass: where each role's run starts and ends (a role with two runs, or none, fails).
