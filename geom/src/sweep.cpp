@@ -333,6 +333,42 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
   return emit(sc.hull, out, sc.spare);
 }
 
+namespace {
+
+// Upper envelope (max) of the lines L_d(h) = s_d·h + ρ_d of sc.disks (sorted by slope) over
+// all h, in sc.env; sc.breaks[i] is where env[i] overtakes env[i-1] (ramp_hull()).
+void upper_envelope(SectionScratch& sc) {
+  auto& disks = sc.disks;
+  auto& env = sc.env;
+  auto& br = sc.breaks;
+  env.clear();
+  br.clear();
+  auto cross_at = [&](int a, int b) { return (disks[a].r - disks[b].r) / (disks[b].s - disks[a].s); };
+  for (int i = 0; i < static_cast<int>(disks.size()); ++i) {
+    if (!env.empty() && disks[env.back()].s == disks[i].s) {  // same slope: the larger ρ (later) wins
+      env.pop_back();
+      br.pop_back();
+    }
+    while (!env.empty()) {
+      const double x = cross_at(env.back(), i);
+      if (env.size() >= 2 && x <= br.back()) {
+        env.pop_back();
+        br.pop_back();
+        continue;
+      }
+      env.push_back(i);
+      br.push_back(x);
+      break;
+    }
+    if (env.empty()) {
+      env.push_back(i);
+      br.push_back(-INFINITY);
+    }
+  }
+}
+
+}  // namespace
+
 // Hull of several n-gons on one angle grid whose centres lie on the line of motion (a ramp),
 // without sorting points. Disk d has centre c0 + s_d·e (e: unit horizontal direction of the
 // motion) and circumradius ρ_d. For a direction θ = θ_k + δ with |δ| <= π/n the support
@@ -368,34 +404,9 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
     }
     disks[j] = d;
   }
-  // Upper envelope (max) of L_d(h) = s_d·h + ρ_d over all h; breaks[i] is where env[i]
-  // overtakes env[i-1].
-  auto& env = sc.env;
-  auto& br = sc.breaks;
-  env.clear();
-  br.clear();
-  auto cross_at = [&](int a, int b) { return (disks[a].r - disks[b].r) / (disks[b].s - disks[a].s); };
-  for (int i = 0; i < static_cast<int>(disks.size()); ++i) {
-    if (!env.empty() && disks[env.back()].s == disks[i].s) {  // same slope: the larger ρ (later) wins
-      env.pop_back();
-      br.pop_back();
-    }
-    while (!env.empty()) {
-      const double x = cross_at(env.back(), i);
-      if (env.size() >= 2 && x <= br.back()) {
-        env.pop_back();
-        br.pop_back();
-        continue;
-      }
-      env.push_back(i);
-      br.push_back(x);
-      break;
-    }
-    if (env.empty()) {
-      env.push_back(i);
-      br.push_back(-INFINITY);
-    }
-  }
+  upper_envelope(sc);
+  const auto& env = sc.env;
+  const auto& br = sc.breaks;
   const int m = static_cast<int>(env.size());
   // Index of the envelope piece that wins at h.
   auto piece = [&](double h) {

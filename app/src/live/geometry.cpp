@@ -178,6 +178,7 @@ bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
         kernel(std::span<const geom::SweepRef>(&piece, 1));
       }
     } else {
+      j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
       kernel(batch.subspan(i, j - i));
     }
     i = j;

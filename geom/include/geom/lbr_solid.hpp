@@ -78,6 +78,17 @@ struct SweepRef {
   const TurningShape* turning = nullptr;
 };
 
+// Where a batch of `moves` should end so that the path in it does not come round on itself
+// in a tight loop: the number of leading moves (at least one, at most moves.size()) before
+// the XY path of consecutive milling moves of one tool has turned a full circle while
+// staying within a square of side kTightLoopDiameters tool diameters. A tight helix (a bore,
+// a ramp entry, thread milling) turns on one spot, and one difference fed with several of
+// its turns carries every turn's outline over the same annulus: the Vatti sweep's cost grows
+// with the square of those crossing edges, while batches of one turn each stay linear.
+// Loops wider than that (a pocket's passes) are not cut. Real-time safe.
+inline constexpr double kTightLoopDiameters = 2.0;
+[[nodiscard]] std::size_t tight_loop_end(std::span<const SweepRef> moves) noexcept;
+
 struct SubtractStats {
   std::uint64_t sections = 0;       // section polygons computed
   std::uint64_t cells_tested = 0;   // (region, level) pairs that passed the box tests
