@@ -45,6 +45,19 @@ struct Cell {
                              // (colour by time of a floor whose level above was cut away)
 };
 
+// How a rectangle meets the material of a cell (cover_of()).
+enum class RectCover : std::uint8_t {
+  None,    // no material in the rectangle
+  All,     // the rectangle lies inside the material
+  Partly,  // some contour edge comes near the rectangle: only a clip tells
+};
+
+// Where rectangle r lies against the cell's material: when no contour edge's box meets r,
+// r lies wholly inside or wholly outside the material and its centre decides which.
+// Conservative (Partly where an edge's box meets r but the edge misses it). O(vertices of
+// the polygons whose box meets r), no allocation.
+[[nodiscard]] RectCover cover_of(const Cell& cell, const Rect& r) noexcept;
+
 struct BoxStock {
   Vec3 min, max;  // [mm]
 };
