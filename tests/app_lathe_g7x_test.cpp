@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -328,6 +329,45 @@ TEST(LatheG7x, VariantsFollowRs274) {
   for (const char* c : {"G72 Q2 X32 Z2 I0.8 R0.5 D0.3", "G72.1 Q2 X32 Z2 I1 R0.5 D0.5", "G72.2 Q2 X32 Z2 I0.8 R0.5 D0.3",
                         "G70 Q2 X32 Z2 D0.5 E0.1 P2"})
     expect_rapids_as_rs274(face + c + "\nM2\n");
+}
+
+TEST(LatheG7x, FeedInTheProfileSubroutineIsIgnored) {
+  // Regression: the subroutine's F50 used to become the cycle's feed; LinuxCNC ignores it.
+  nc::GcodeOptions o;
+  o.machine = nc::MachineKind::Lathe;
+  const nc::Toolpath tp = nc::interpret_gcode(
+      "G18 G8 G21 G90\nF100\nO1 SUB\n G0 X5 Z1\n G1 Z-10 F50\n X12\nO1 ENDSUB\nG0 X20 Z3\nG71 Q1 X15 Z3\nG1 X20\nM2\n",
+      "t.ngc", o);
+  int feeds = 0;
+  for (const nc::Segment& s : tp.segments) {
+    if (s.kind != nc::SegmentKind::Feed) continue;
+    EXPECT_DOUBLE_EQ(s.feed_mm_per_min, 100.0);
+    ++feeds;
+  }
+  EXPECT_GT(feeds, 5);
+}
+
+// LinuxCNC's two G7x sample programs (tests/data/nc_corpus_exclusions.txt no longer lists
+// them), radius mode, with tool 1 loaded: the built-in tool path removes what rs274's removes.
+TEST(LatheG7x, LinuxCncSamplesRemoveWhatRs274Removes) {
+  if (nc::find_rs274().empty()) GTEST_SKIP() << "linuxcnc-uspace is not installed";
+  FILE* p = ::popen("dpkg -L linuxcnc-uspace 2>/dev/null | grep 'lathe_g7x_.*\\.ngc$' | sort", "r");
+  ASSERT_NE(p, nullptr);
+  std::vector<std::string> files;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) files.emplace_back(buf, std::strcspn(buf, "\n"));
+  ::pclose(p);
+  EXPECT_EQ(files.size(), 2u);
+  for (const std::string& f : files) {
+    SCOPED_TRACE(f);
+    std::ifstream in(f);
+    std::stringstream ss;
+    ss << "G8 T1 M6\n" << in.rdbuf();
+    const double builtin = removed_mm3(ss.str(), app::Interpreter::Builtin);
+    const double rs274 = removed_mm3(ss.str(), app::Interpreter::Rs274);
+    EXPECT_GT(builtin, 1000.0);
+    EXPECT_NEAR(builtin, rs274, 1e-3 * rs274);
+  }
 }
 
 }  // namespace

@@ -1191,9 +1191,11 @@ class Interpreter {
     return p;
   }
 
+  // The subroutine's F words do not change the cycle's feed (LinuxCNC ignores them there).
   std::vector<detail::LathePoint> capture_profile(int q, const AxisVector& start) {
     std::vector<detail::LathePoint> profile;
     const int motion = motion_, line = line_;
+    const double feed = feed_;
     b_.set_position(start);
     capture_ = &profile;
     try {
@@ -1203,7 +1205,7 @@ class Interpreter {
       throw;
     }
     capture_ = nullptr;
-    motion_ = motion, line_ = line;
+    motion_ = motion, line_ = line, feed_ = feed;
     return profile;
   }
 
