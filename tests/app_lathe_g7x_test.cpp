@@ -331,6 +331,27 @@ TEST(LatheG7x, VariantsFollowRs274) {
     expect_rapids_as_rs274(face + c + "\nM2\n");
 }
 
+TEST(LatheG7x, OffsetProfileStartsWhereItMeetsAShortFirstSegmentsExtension) {
+  // Profile (radius mode): X5 Z1, X4.8 (0.2 along -X), X10 Z-5, Z-10; G70 at E0.5 (one pass,
+  // 0.5 from the profile towards the start point X15 Z3). The short first segment offset lies
+  // at Z0.5 (X4.8..5); the offset diagonal does not reach it but crosses its extension at
+  // X = 5.895: the pass starts there (LinuxCNC's stepwise offset ends up elsewhere).
+  const double len = std::hypot(6.0, 5.2), nz = 5.2 / len * 0.5, nx = 6.0 / len * 0.5;  // normal (Z, X) * 0.5
+  const double t = (1.0 + nz - 0.5) / 6.0;  // along the diagonal from its offset start to Z0.5
+  const double want_x = 4.8 + nx + t * 5.2;
+  nc::GcodeOptions o;
+  o.machine = nc::MachineKind::Lathe;
+  const nc::Toolpath tp = nc::interpret_gcode(
+      "G18 G8 G21 G90\nF100\nO1 SUB\n G0 X5 Z1\n G1 X4.8\n X10 Z-5\n Z-10\nO1 ENDSUB\nG70 Q1 X15 Z3 E0.5\nM2\n", "t.ngc", o);
+  const std::vector<std::array<double, 3>> p = path_of(tp);
+  ASSERT_GE(p.size(), 4u);
+  EXPECT_NEAR(p[1][0], want_x, 1e-9);  // after the rapid to the start point
+  EXPECT_NEAR(p[1][1], 0.5, 1e-9);
+  EXPECT_EQ(p[1][2], 0.0);
+  EXPECT_NEAR(p.back()[0], 10.5, 1e-9);  // the last segment offset 0.5 along +X
+  EXPECT_NEAR(p.back()[1], -10.0, 1e-9);
+}
+
 TEST(LatheG7x, FeedInTheProfileSubroutineIsIgnored) {
   // Regression: the subroutine's F50 used to become the cycle's feed; LinuxCNC ignores it.
   nc::GcodeOptions o;

@@ -68,8 +68,8 @@ void normalise(Frame& f, std::vector<V>& pts, std::size_t first) {
   }
 }
 
-bool runs_back(const std::vector<V>& pts) {
-  for (std::size_t k = 0; k + 1 < pts.size(); ++k)
+bool runs_back(const std::vector<V>& pts, std::size_t from = 0) {
+  for (std::size_t k = from; k + 1 < pts.size(); ++k)
     if (pts[k + 1].p - pts[k].p > kMonotonic) return true;
   return false;
 }
@@ -121,7 +121,10 @@ void round_corner(std::vector<V>& out, V c, V a, V b, double d) {
 }
 
 // The path with its profile (pts[1..]) offset by d towards the start point (LinuxCNC's sign
-// rule), outer corners rounded; the approach line then ends at the offset profile's start.
+// rule), outer corners rounded. The free ends move square to their segments, unless the
+// other offset segments cross a segment's extension there (a short end segment swallowed by
+// the offset): then the profile starts or ends at that crossing. The approach line then ends
+// at the offset profile's start.
 std::vector<V> offset_path(const std::vector<V>& pts, double d) {
   if (d == 0.0) return pts;
   const std::size_t n = pts.size();
@@ -137,7 +140,14 @@ std::vector<V> offset_path(const std::vector<V>& pts, double d) {
     q.push_back(b);
     q.push_back(pts[k + 1] + normal(k));
   }
+  constexpr double kFar = 1e4;  // [mm]
+  const V d0 = pts[2] - pts[1], d1 = pts[n - 1] - pts[n - 2];
+  q.insert(q.begin(), q.front() - (kFar / norm(d0)) * d0);
+  q.push_back(q.back() + (kFar / norm(d1)) * d1);
   remove_loops(q);
+  q.erase(q.begin());
+  q.pop_back();
+  if (q.size() < 2) throw std::invalid_argument("D is too large for the profile: nothing of it is left");
   q.insert(q.begin(), pts[0]);
   return q;
 }
@@ -300,8 +310,11 @@ std::vector<LathePoint> roughing(const std::vector<LathePoint>& profile, const L
   std::vector<V> pts = to_frame(f, start, profile);
   normalise(f, pts, 1);
   make_monotonic(pts, f.along_x ? "X" : "Z");
+  std::vector<V> path = offset_path(pts, c.allowance);
+  if (runs_back(path, 1))  // the approach may (LinuxCNC does not check it after the offset)
+    throw std::invalid_argument("D is too large for the profile: offset, it runs back along the passes");
   std::vector<Move> moves;
-  Roughing(offset_path(pts, c.allowance), c.increment, c.retract, moves).run(c.variant);
+  Roughing(std::move(path), c.increment, c.retract, moves).run(c.variant);
   return from_frame(f, moves);
 }
 
