@@ -183,6 +183,7 @@ TEST(LatheG7x, RefusesWhatItDoesNotDo) {
   EXPECT_EQ(error_of(sub + "G71 Q1 X15 Z3 D-0.5\n"), "t.ngc:8: 'G71': D (distance left to the profile) must be >= 0");
   EXPECT_EQ(error_of(sub + "G72.1 Q1 X15 Z3 I0\n"), "t.ngc:8: 'G72.1': I (cut increment) must be > 0");
   EXPECT_EQ(error_of(sub + "G70 Q1 X15 Z3 P0\n"), "t.ngc:8: 'P0': expected an integer in [1, 1000]");
+  EXPECT_EQ(error_of(sub + "G71 Q1 X15 Z3 I0.00001\n"), "t.ngc:8: 'G71': more than 100000 levels (I too small)");
   EXPECT_EQ(error_of(sub + "G17 G71 Q1 X15 Z3\n"), "t.ngc:8: 'G71' needs the XZ plane (G18)");
   const std::string back = "G18 G8 G21\nF100\nO1 SUB\n G0 X5 Z1\n G1 X12 Z-5\n X8 Z-10\nO1 ENDSUB\n";
   EXPECT_EQ(error_of(back + "G72 Q1 X15 Z3\n"),

@@ -13,6 +13,8 @@ constexpr double kTol = 1e-6;       // LinuxCNC's tolerance for "on the level", 
 constexpr double kMonotonic = 1e-3;  // how far a segment may run back along the pass axis [mm]
 constexpr double kChord = 0.001;     // chord error of the round corners of an offset profile [mm]
 constexpr long kMaxSteps = 1000000;
+constexpr std::size_t kMaxPoints = 20000;  // profile points (chords): the offset is quadratic in them
+constexpr double kMaxLevels = 100000;      // roughing levels (range across the passes / I)
 
 // A point in the normalised frame: p along the passes (the profile runs towards −p), l across
 // them (the level; passes step towards −l from the start point).
@@ -52,6 +54,8 @@ std::vector<V> to_frame(const Frame& f, const LathePoint& start, const std::vect
     if (norm(v - pts.back()) > 1e-12) pts.push_back(v);
   }
   if (pts.size() < 3) throw std::invalid_argument("the profile subroutine makes fewer than two moves");
+  if (pts.size() > kMaxPoints)
+    throw std::invalid_argument("the profile has more than " + std::to_string(kMaxPoints) + " points (arcs count as chords)");
   return pts;
 }
 
@@ -97,7 +101,9 @@ bool crossing(V a, V b, V c, V d, V& at) {
 // Cut out the loops an offset makes at inner corners and across narrow features.
 void remove_loops(std::vector<V>& q) {
   for (std::size_t i = 0; i + 3 < q.size(); ++i) {
+    const double lo = std::min(q[i].p, q[i + 1].p), hi = std::max(q[i].p, q[i + 1].p);
     for (std::size_t j = q.size() - 2; j >= i + 2; --j) {
+      if (std::max(q[j].p, q[j + 1].p) < lo || std::min(q[j].p, q[j + 1].p) > hi) continue;
       V at;
       if (!crossing(q[i], q[i + 1], q[j], q[j + 1], at)) continue;
       q.erase(q.begin() + static_cast<long>(i) + 1, q.begin() + static_cast<long>(j) + 1);
@@ -310,6 +316,10 @@ std::vector<LathePoint> roughing(const std::vector<LathePoint>& profile, const L
   std::vector<V> pts = to_frame(f, start, profile);
   normalise(f, pts, 1);
   make_monotonic(pts, f.along_x ? "X" : "Z");
+  double lo = pts[0].l, hi = lo;
+  for (const V& v : pts) lo = std::min(lo, v.l), hi = std::max(hi, v.l);
+  if ((hi - lo) / c.increment > kMaxLevels)
+    throw std::invalid_argument("more than " + std::to_string(static_cast<long>(kMaxLevels)) + " levels (I too small)");
   std::vector<V> path = offset_path(pts, c.allowance);
   if (runs_back(path, 1))  // the approach may (LinuxCNC does not check it after the offset)
     throw std::invalid_argument("D is too large for the profile: offset, it runs back along the passes");
