@@ -184,6 +184,13 @@ TEST(LatheG7x, RefusesWhatItDoesNotDo) {
   EXPECT_EQ(error_of(sub + "G72.1 Q1 X15 Z3 I0\n"), "t.ngc:8: 'G72.1': I (cut increment) must be > 0");
   EXPECT_EQ(error_of(sub + "G70 Q1 X15 Z3 P0\n"), "t.ngc:8: 'P0': expected an integer in [1, 1000]");
   EXPECT_EQ(error_of(sub + "G71 Q1 X15 Z3 I0.00001\n"), "t.ngc:8: 'G71': more than 100000 levels (I too small)");
+  const std::string corner = "G18 G8 G21\nF100\nO1 SUB\n G0 X5 Z1\n G1 Z-10 ";
+  EXPECT_EQ(error_of(corner + "A1 C1\n X12\nO1 ENDSUB\nG71 Q1 X15 Z3\n"),
+            "t.ngc:5: 'A1' and 'C1': a corner takes a fillet or a chamfer");
+  EXPECT_EQ(error_of(corner + "A3\n X7\nO1 ENDSUB\nG71 Q1 X15 Z3\n"),
+            "t.ngc:8: 'G71': the corner finish 3 mm does not fit the straight moves at X5 Z-10 (arcs take none)");
+  EXPECT_EQ(error_of(corner + "A1\n X12\nO1 ENDSUB\nG1 X5 A1\n"),
+            "t.ngc:8: word 'A1' needs an axis the machine lacks (machine kind mill3 has X Y Z)");
   EXPECT_EQ(error_of(sub + "G17 G71 Q1 X15 Z3\n"), "t.ngc:8: 'G71' needs the XZ plane (G18)");
   const std::string back = "G18 G8 G21\nF100\nO1 SUB\n G0 X5 Z1\n G1 X12 Z-5\n X8 Z-10\nO1 ENDSUB\n";
   EXPECT_EQ(error_of(back + "G72 Q1 X15 Z3\n"),
@@ -351,6 +358,32 @@ TEST(LatheG7x, OffsetProfileStartsWhereItMeetsAShortFirstSegmentsExtension) {
   EXPECT_EQ(p[1][2], 0.0);
   EXPECT_NEAR(p.back()[0], 10.5, 1e-9);  // the last segment offset 0.5 along +X
   EXPECT_NEAR(p.back()[1], -10.0, 1e-9);
+}
+
+TEST(LatheG7x, CornerFinishesRoundAndCutTheCorners) {
+  // A1 at X5 Z-10 (90-degree corner): tangent points 1 from the corner, (5, -9) and (6, -10),
+  // arc about (6, -9); C1 at X12 Z-20: a straight cut from (12, -19) to (13, -20).
+  const std::string prog = "G18 G8 G21 G90\nF100\nO1 SUB\n G0 X5 Z1\n G1 Z-10 A1\n X12\n Z-20 C1\n X15\nO1 ENDSUB\n"
+                           "G0 X20 Z3\nG70 Q1 X15 Z3\nM2\n";
+  nc::GcodeOptions o;
+  o.machine = nc::MachineKind::Lathe;
+  const std::vector<std::array<double, 3>> p = path_of(nc::interpret_gcode(prog, "t.ngc", o));
+  auto index_of = [&](double x, double z) {
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (std::abs(p[i][0] - x) < 1e-9 && std::abs(p[i][1] - z) < 1e-9) return static_cast<long>(i);
+    return -1L;
+  };
+  const long t1 = index_of(5, -9), t2 = index_of(6, -10), c1 = index_of(12, -19), c2 = index_of(13, -20);
+  ASSERT_GE(t1, 0);
+  ASSERT_GT(t2, t1 + 1);  // chords of the fillet between
+  for (long i = t1; i <= t2; ++i) EXPECT_NEAR(std::hypot(p[i][0] - 6.0, p[i][1] + 9.0), 1.0, 1e-9) << i;
+  ASSERT_GE(c1, 0);
+  EXPECT_EQ(c2, c1 + 1);
+  EXPECT_EQ(index_of(5, -10), -1L);  // the corners themselves are gone
+  EXPECT_EQ(index_of(12, -20), -1L);
+  expect_rapids_as_rs274(prog);
+  expect_rapids_as_rs274("G18 G8 G21 G90\nF100\nO1 SUB\n G0 X10 Z1\n G1 Z-5 C1\n X16 Z-10 A2\n Z-14 A0.5\n X11 Z-18 C0.7\n"
+                         " Z-24\n G1 X20 Z-32 A1\n Z-36\n X22\nO1 ENDSUB\nG0 X30 Z5\nG71 Q1 X24 Z3 I1 R0.5 D0.7\nM2\n");
 }
 
 TEST(LatheG7x, FeedInTheProfileSubroutineIsIgnored) {

@@ -447,9 +447,10 @@ class Interpreter {
     }
     set_modes(b, k);
     if (k.mstate != nullptr) modal_state(*k.mstate);
-    // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing).
+    // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing; in a
+    // G7x profile A and C are corner finishes).
     for (int a = 0; a < kAxes; ++a)
-      if (has(b, kAxisLetters[a]) && !axis_allowed(a) && k.g10 == 0)
+      if (has(b, kAxisLetters[a]) && !axis_allowed(a) && k.g10 == 0 && !(capture_ != nullptr && (a == 3 || a == 5)))
         fail("word '" + text(b, kAxisLetters[a]) + "' needs an axis the machine lacks (machine kind " + machine_name() + ")");
     move(b, k);
     check_all_words_used(b);
@@ -707,8 +708,25 @@ class Interpreter {
     b_.set_position(b_.from_machine(m));
   }
 
-  // 8. G10, G28/G30, G53; 9. motion
+  // 8. G10, G28/G30, G53; 9. motion. While a G7x profile is recorded, A (fillet) and C
+  // (chamfer) are corner finishes at the move's end, as LinuxCNC reads them there.
   void move(Block& b, const Codes& k) {
+    if (capture_ == nullptr) return move_block(b, k);
+    double radius = 0.0;
+    bool chamfer = false;
+    if (has(b, 'A') && has(b, 'C')) fail("'" + text(b, 'A') + "' and '" + text(b, 'C') + "': a corner takes a fillet or a chamfer");
+    for (char L : {'A', 'C'}) {
+      if (!has(b, L)) continue;
+      radius = len(b, L), chamfer = L == 'C';
+      if (!(radius > 0.0)) fail("'" + text(b, L) + "': a corner finish needs a size > 0");
+      b.has[idx(L)] = false;
+    }
+    const std::size_t before = capture_->size();
+    move_block(b, k);
+    if (radius > 0.0 && capture_->size() > before) capture_->back().corner = radius, capture_->back().chamfer = chamfer;
+  }
+
+  void move_block(Block& b, const Codes& k) {
     if (k.g[kMotion] && is_lathe_profile_cycle(code10(*k.g[kMotion]))) {
       lathe_profile_cycle(b, code10(*k.g[kMotion]), k.f_in_block);
       return;

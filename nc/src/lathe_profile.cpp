@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +27,12 @@ V operator-(V a, V b) { return {a.p - b.p, a.l - b.l}; }
 V operator*(double s, V a) { return {s * a.p, s * a.l}; }
 double cross(V a, V b) { return a.p * b.l - a.l * b.p; }
 double norm(V a) { return std::hypot(a.p, a.l); }
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
 
 struct Move {
   V to;
@@ -352,12 +359,54 @@ std::vector<LathePoint> finishing(const std::vector<LathePoint>& profile, const 
   return from_frame(f, moves);
 }
 
+// LinuxCNC's corner finishes: a fillet (A) of radius r or a chamfer (C, the same end points)
+// at a corner, tangent to the two straight moves meeting there, r·tan(turn/2) from the corner.
+// A finish on the last move has no corner (ignored, as LinuxCNC).
+std::vector<LathePoint> with_corner_finishes(const LathePoint& start, const std::vector<LathePoint>& profile) {
+  std::vector<LathePoint> out;
+  auto v = [](const LathePoint& q) { return V{q.z, q.x}; };
+  for (std::size_t k = 0; k < profile.size(); ++k) {
+    const LathePoint& q = profile[k];
+    if (q.corner <= 0.0 || k + 1 == profile.size()) {
+      out.push_back(q);
+      continue;
+    }
+    const V a = v(out.empty() ? start : out.back()), c = v(q), b = v(profile[k + 1]);
+    const double la = norm(c - a), lb = norm(b - c);
+    if (la < 1e-12 || lb < 1e-12) throw std::invalid_argument("a corner finish at a move of zero length");
+    const V u = (1.0 / la) * (c - a), w = (1.0 / lb) * (b - c);
+    const double turn = std::atan2(std::abs(cross(u, w)), u.p * w.p + u.l * w.l);
+    if (turn < 1e-9) {
+      out.push_back(q);
+      continue;
+    }
+    const double t = q.corner * std::tan(turn / 2.0);
+    if (t > la + 1e-9 || t > lb + 1e-9)
+      throw std::invalid_argument("the corner finish " + num(q.corner) + " mm does not fit the straight moves at X" +
+                                  num(q.x) + " Z" + num(q.z) + " (arcs take none)");
+    std::vector<V> pts{c - t * u};
+    if (!q.chamfer) {
+      const double side = cross(u, w) > 0.0 ? 1.0 : -1.0;
+      const V centre = pts[0] + (side * q.corner) * V{-u.l, u.p};
+      round_corner(pts, centre, pts[0], c + t * w, q.corner);
+    }
+    pts.push_back(c + t * w);
+    for (const V& p : pts) {
+      LathePoint r;
+      r.x = p.l, r.z = p.p;
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<LathePoint> lathe_cycle(const std::vector<LathePoint>& profile, const LathePoint& start,
                                     const LatheCycle& cycle) {
-  if (cycle.code == 70) return finishing(profile, start, cycle);
-  return roughing(profile, start, cycle);
+  const std::vector<LathePoint> finished = with_corner_finishes(start, profile);
+  if (cycle.code == 70) return finishing(finished, start, cycle);
+  return roughing(finished, start, cycle);
 }
 
 }  // namespace lbr::nc::detail

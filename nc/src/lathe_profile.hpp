@@ -11,6 +11,7 @@
 //    retracting R at 45 degrees, follows the profile up and cuts each pocket (a stretch where
 //    the profile goes down again: type 2) the same way;
 //  * finishing (G70) runs P passes along the profile offset by (pass−1)(D−E)/P + E.
+// Corner finishes (A, C on a profile move) are applied first, between straight neighbours.
 // docs/nc-frontend.md#lathe-cycles-g76-g7x. Not real-time code: allocates and throws
 // std::invalid_argument (the caller adds FILE:LINE).
 #pragma once
@@ -22,6 +23,8 @@ namespace lbr::nc::detail {
 struct LathePoint {
   double x = 0.0, z = 0.0;  // radius [mm], Z [mm]
   bool rapid = false;       // reached by a rapid move
+  double corner = 0.0;      // profile: fillet radius (A) or chamfer size (C) at this corner [mm]
+  bool chamfer = false;
 };
 
 struct LatheCycle {
