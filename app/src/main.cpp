@@ -322,7 +322,7 @@ struct RunOptions {
   app::LiveOptions live;
   bool quiet = false;
   // rendering (gfx/): a viewer window when a display exists, screenshots on request
-  bool no_window = false, hidden = false, no_tool = false, no_ui = false;
+  bool no_window = false, hidden = false, no_tool = false, no_ui = false, kiosk = false;
   int screenshot_every = 0;
   std::string screenshot_prefix;  // empty: OUT/frame-
   std::string view = "iso", color = "heat", size = "1280x800";
@@ -391,6 +391,7 @@ gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profi
   rc.ui.enabled = !o.no_ui && !o.hidden && !o.no_window;
   rc.ui.scale = profile.render.ui.scale;
   rc.ui.source = o.live.source;
+  rc.ui.kiosk = o.kiosk;
   return rc;
 }
 
@@ -460,7 +461,7 @@ class HudNotice {
 app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profile, const app::StatusFn& status) {
   const gfx::RenderThreadConfig rc = live_render_config(o, profile);
   const bool visible = !o.hidden && !o.no_window;
-  gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source);
+  gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source, o.kiosk);
   gfx::SolidExchange ex(1 << 14);
   std::promise<std::unique_ptr<geom::LbrSolid>> initial;
   auto initial_ready = initial.get_future();
@@ -498,7 +499,7 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
     set_render_thread(&rt);
     notice.attach(&rt);
     if (visible) {
-      gfx::run_event_loop(win, rt, [&] { return !live_done.load(); });
+      gfx::run_event_loop(win, rt, [&] { return !live_done.load(); }, o.kiosk);
       if (!live_done.load() && rt.running()) {  // the window was closed: end the run, keep its results
         g_window_closed.store(true);
         g_stop.store(true);
@@ -720,6 +721,7 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_flag("--no-window", ro.no_window, "Do not open the viewer even when a display exists");
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
   run->add_flag("--no-ui", ro.no_ui, "Hide the operator UI (status bar, view controls); the text HUD instead");
+  run->add_flag("--kiosk", ro.kiosk, "Full screen without decorations; quitting asks for a confirmation");
   run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "
                   "headless: xvfb-run -a)")->check(CLI::Range(0, 1000000));
   run->add_option("--screenshot-prefix", ro.screenshot_prefix,
