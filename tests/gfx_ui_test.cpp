@@ -389,6 +389,55 @@ TEST_F(GfxUi, KioskQuitNeedsTheConfirmation) {
 
 // Not a check: with LBR_UI_SCREENSHOTS=DIR set, writes the pictures in docs/ui.md at the two
 // panel sizes (1024x768, 1280x800).
+// Taps at the window points where known points of the part project (top view): the panel
+// gets their coordinates (the pocket floor at z = -3, the top face at z = 0), the material
+// below them (7 and 10 mm) and their distance; a tap beside the part picks nothing.
+TEST_F(GfxUi, MeasureTapsReportThePointTheStockBelowAndTheDistance) {
+  UiWindow w(pocketed(), gfx::StandardView::Top);
+  w.tap("Measure");
+  ASSERT_TRUE(wait_for([&] { return w.rt().measuring(); }));
+  (void)w.item("Clear");  // the panel is up
+  const gfx::Camera cam = w.state().first;
+  auto tap_at = [&](glm::dvec3 p) {
+    const glm::dvec2 q = cam.project(p, kW, kH);
+    ASSERT_FALSE(w.rt().ui_hit(q.x, q.y)) << p.x << "," << p.y << " lies under the UI";
+    w.tap(q.x, q.y);
+  };
+  constexpr double kDeltaMm = 0.01;  // the tap lands where the point projects; the pick inverts it
+  tap_at({20, 15, 0});
+  ASSERT_TRUE(wait_for([&] { return w.rt().measured().size() == 1; }));
+  gfx::MeasurePoint a = w.rt().measured()[0];
+  EXPECT_NEAR(a.x_mm, 20, kDeltaMm);
+  EXPECT_NEAR(a.y_mm, 15, kDeltaMm);
+  EXPECT_NEAR(a.z_mm, kFloorZ, 1e-9);
+  EXPECT_TRUE(a.top_face);
+  EXPECT_NEAR(a.thickness_mm, 10 + kFloorZ, 1e-9);
+  EXPECT_NEAR(a.surface_z_mm, kFloorZ, 1e-9);
+  tap_at({25, 27, 0});
+  ASSERT_TRUE(wait_for([&] { return w.rt().measured().size() == 2; }));
+  const gfx::MeasurePoint b = w.rt().measured()[1];
+  EXPECT_NEAR(b.x_mm, 25, kDeltaMm);
+  EXPECT_NEAR(b.y_mm, 27, kDeltaMm);
+  EXPECT_NEAR(b.z_mm, 0, 1e-9);
+  EXPECT_NEAR(b.thickness_mm, 10, 1e-9);
+  const double d = std::sqrt((b.x_mm - a.x_mm) * (b.x_mm - a.x_mm) + (b.y_mm - a.y_mm) * (b.y_mm - a.y_mm) +
+                             (b.z_mm - a.z_mm) * (b.z_mm - a.z_mm));
+  EXPECT_NEAR(d, std::sqrt(5.0 * 5.0 + 12.0 * 12.0 + 3.0 * 3.0), 2 * kDeltaMm);
+  // Beside the part: a miss, the points stay.
+  tap_at({-1, 15, 0});
+  ASSERT_TRUE(wait_for([&] { return w.rt().measure_misses() == 1; }));
+  EXPECT_EQ(w.rt().measured().size(), 2U);
+  // A drag in Measure mode still orbits and picks nothing.
+  const double yaw = w.state().first.yaw;
+  w.drag(500, 300, 600, 300);
+  EXPECT_NE(w.state().first.yaw, yaw);
+  EXPECT_EQ(w.rt().measured().size(), 2U);
+  EXPECT_EQ(w.rt().measure_misses(), 1U);
+  // The switch turns the mode off again.
+  w.tap("Measure");
+  ASSERT_TRUE(wait_for([&] { return !w.rt().measuring(); }));
+}
+
 TEST_F(GfxUi, Screenshots) {
   const char* dir = std::getenv("LBR_UI_SCREENSHOTS");
   if (dir == nullptr) GTEST_SKIP() << "set LBR_UI_SCREENSHOTS=DIR to write the docs' screenshots";
@@ -404,6 +453,17 @@ TEST_F(GfxUi, Screenshots) {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     gfx::write_png(std::string(dir) + "/ui-" + std::to_string(wpx) + "x" + std::to_string(hpx) + ".png", w.frame());
   }
+  // The Measure panel: two points on the iso view (pocket floor, top face).
+  UiWindow w(s, gfx::StandardView::Iso);
+  w.tap("Measure");
+  (void)w.item("Clear");
+  const gfx::Camera cam = w.state().first;
+  for (glm::dvec3 p : {glm::dvec3{20, 15, kFloorZ}, glm::dvec3{25, 27, 0}}) {
+    const glm::dvec2 q = cam.project(p, kW, kH);
+    w.tap(q.x, q.y);
+  }
+  (void)wait_for([&] { return w.rt().measured().size() == 2; });
+  gfx::write_png(std::string(dir) + "/ui-measure.png", w.frame());
 }
 
 }  // namespace
