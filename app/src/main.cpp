@@ -392,6 +392,10 @@ gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profi
   rc.ui.scale = profile.render.ui.scale;
   rc.ui.source = o.live.source;
   rc.ui.kiosk = o.kiosk;
+  // The program panel: --program, or the emulator's program file.
+  const std::string emu = o.live.source.rfind("emulator:", 0) == 0 ? o.live.source.substr(9) : "";
+  if (!o.live.program.empty()) rc.ui.program = app::program_text(o.live.program);
+  else if (!emu.empty() && emu != "demo") rc.ui.program = app::program_text(emu);
   return rc;
 }
 
@@ -702,6 +706,10 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_option("--source", ro.live.source,
                   "can:IFACE | serial:DEVICE | replay:LOGFILE | emulator:PROGRAM (PROGRAM 'demo' = bundled demo)")
       ->capture_default_str();
+  run->add_option("--program", ro.live.program,
+                  "The part program the machine runs (can, serial, replay sources): its current line is found from "
+                  "the sampled positions and its emulated time gives the progress")
+      ->check(CLI::ExistingFile);
   run->add_option("--stl", ro.stl, "Also write the final part as binary STL");
   run->add_option("--ply", ro.ply, "Also write the final part as binary PLY (with move ids)");
   run->add_option("--profile", ro.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
