@@ -10,12 +10,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <future>
 #include <functional>
 #include <memory>
 #include <thread>
 
 #include <glm/glm.hpp>
 
+#include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "app/view.hpp"
@@ -51,7 +53,8 @@ bool is_background(const std::uint8_t* p) {  // the clear colour (0.13, 0.14, 0.
 class UiWindow {
  public:
   UiWindow(const geom::LbrSolid& solid, gfx::StandardView view, gfx::ReplayControl* replay = nullptr, int width = kW,
-           int height = kH, bool kiosk = false, std::vector<std::string> program = {}) {
+           int height = kH, bool kiosk = false, std::vector<std::string> program = {}, std::string source = "gfx_ui_test",
+           gfx::SolidExchange* exchange = nullptr) {
     win_ = std::make_unique<gfx::Window>(width, height, true, "gfx_ui_test");
     gfx::RenderThreadConfig cfg;
     cfg.rate_hz = 20;
@@ -63,11 +66,11 @@ class UiWindow {
     cfg.render.show_tools = cfg.render.show_path = false;
     cfg.ui.enabled = true;
     cfg.ui.scale = 1.5f;
-    cfg.ui.source = "gfx_ui_test";
+    cfg.ui.source = std::move(source);
     cfg.ui.replay = replay;
     cfg.ui.kiosk = kiosk;
     cfg.ui.program = std::move(program);
-    rt_ = std::make_unique<gfx::RenderThread>(*win_, ex_, solid, cfg);
+    rt_ = std::make_unique<gfx::RenderThread>(*win_, exchange != nullptr ? *exchange : ex_, solid, cfg);
     router_ = std::make_unique<gfx::EventRouter>(*rt_, height);
     rt_->start();
   }
@@ -438,6 +441,31 @@ TEST_F(GfxUi, MeasureTapsReportThePointTheStockBelowAndTheDistance) {
   ASSERT_TRUE(wait_for([&] { return !w.rt().measuring(); }));
 }
 
+// `lbrsim run --source emulator:cam-pocket.ngc` as main.cpp runs it (the live pipeline on
+// its own thread, the window on this one), photographed half way.
+void run_screenshot(const std::string& png) {
+  const std::string cfg = std::string(LBR_SOURCE_DIR) + "/config/";
+  const app::Profile p = app::load_profile(cfg + "profiles/default-mill3.toml");
+  const std::string program = cfg + "programs/cam-pocket.ngc";
+  gfx::SolidExchange ex(1 << 14);
+  std::promise<geom::LbrSolid> initial;
+  std::atomic<bool> stop{false};
+  app::LiveOptions o;
+  o.source = "emulator:" + program;
+  o.speed = 25;  // 165 s of machining: a third to half way when the picture is taken
+  o.exchange = &ex;
+  o.on_start = [&](const geom::LbrSolid& s) { initial.set_value(s); };
+  std::thread live([&] { (void)app::run_live(p, o, stop); });
+  {
+    UiWindow w(initial.get_future().get(), gfx::StandardView::Iso, nullptr, kW, kH, false, app::program_text(program),
+               "emulator:config/programs/cam-pocket.ngc", &ex);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+    gfx::write_png(png, w.frame());
+    stop.store(true);
+  }
+  live.join();
+}
+
 TEST_F(GfxUi, Screenshots) {
   const char* dir = std::getenv("LBR_UI_SCREENSHOTS");
   if (dir == nullptr) GTEST_SKIP() << "set LBR_UI_SCREENSHOTS=DIR to write the docs' screenshots";
@@ -453,17 +481,19 @@ TEST_F(GfxUi, Screenshots) {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     gfx::write_png(std::string(dir) + "/ui-" + std::to_string(wpx) + "x" + std::to_string(hpx) + ".png", w.frame());
   }
-  // The Measure panel: two points on the iso view (pocket floor, top face).
-  UiWindow w(s, gfx::StandardView::Iso);
-  w.tap("Measure");
-  (void)w.item("Clear");
-  const gfx::Camera cam = w.state().first;
-  for (glm::dvec3 p : {glm::dvec3{20, 15, kFloorZ}, glm::dvec3{25, 27, 0}}) {
-    const glm::dvec2 q = cam.project(p, kW, kH);
-    w.tap(q.x, q.y);
-  }
-  (void)wait_for([&] { return w.rt().measured().size() == 2; });
-  gfx::write_png(std::string(dir) + "/ui-measure.png", w.frame());
+  {  // The Measure panel: two points on the iso view (pocket floor, top face).
+    UiWindow w(s, gfx::StandardView::Iso);
+    w.tap("Measure");
+    (void)w.item("Clear");
+    const gfx::Camera cam = w.state().first;
+    for (glm::dvec3 p : {glm::dvec3{20, 15, kFloorZ}, glm::dvec3{25, 27, 0}}) {
+      const glm::dvec2 q = cam.project(p, kW, kH);
+      w.tap(q.x, q.y);
+    }
+    (void)wait_for([&] { return w.rt().measured().size() == 2; });
+    gfx::write_png(std::string(dir) + "/ui-measure.png", w.frame());
+  }  // one UI at a time: ImGui's current context is process-wide
+  run_screenshot(std::string(dir) + "/ui-run.png");
 }
 
 }  // namespace
