@@ -52,6 +52,15 @@ TEST(Probe, AHorizontalRayStopsOnThePocketWallAndOnTheStockSide) {
   EXPECT_FALSE(geom::cast_ray(part(), {15, 15, -1.6}, {1, 0, 0}, 0, 15).hit);  // stops short of the wall
 }
 
+TEST(Probe, ARangeStartingInsideTheMaterialAtASlabBoundaryIsAVerticalFace) {
+  // A section plane at x = 20 cuts the ray at (20, 2, -5): a slab boundary (Δ = 0.25).
+  const geom::RayHit h = geom::cast_ray(part(), {30, 2, 5}, {-1, 0, -1}, 10, 100);
+  ASSERT_TRUE(h.hit);
+  EXPECT_DOUBLE_EQ(h.t, 10);
+  EXPECT_NEAR(h.point.z, -5, 1e-12);
+  EXPECT_FALSE(h.top_face);
+}
+
 TEST(Probe, ASlantedRayPassesOverThePocketRimToTheFloor) {
   // From above the corner (x, y) = (50, -15): it enters the stock's top inside the pocket.
   const geom::RayHit h = geom::cast_ray(part(), {50, -15, 27}, {-1, 1, -1});

@@ -132,6 +132,11 @@ RayHit cast_ray(const LbrSolid& s, const Vec3& o, const Vec3& d, double t_min, d
     return h;
   const bool flat = std::abs(d.z) < 1e-12;
   auto at = [&](double t) { return o + t * d; };
+  // A hit at the start of the range is on a horizontal face only when the range starts on
+  // the stock's top; otherwise it starts on a side of the stock or on the caller's limit
+  // (a section plane): a vertical face, even at a slab boundary.
+  const double t_start = t_min;
+  const bool start_on_top = std::abs(at(t_start).z - s.z_top_mm()) < 1e-9;
   const int first = s.level_at(at(t_min).z), last = flat ? first : s.level_at(at(t_max).z);
   const int step = last >= first ? 1 : -1;
   for (int l = first;; l += step) {
@@ -145,7 +150,7 @@ RayHit cast_ray(const LbrSolid& s, const Vec3& o, const Vec3& d, double t_min, d
         h.t = ta + u * (tb - ta);
         h.point = at(h.t);
         h.level = l;
-        h.top_face = u == 0.0 && d.z < 0.0 && std::abs(h.point.z - zt) < 1e-6;
+        h.top_face = u == 0.0 && d.z < 0.0 && std::abs(h.point.z - zt) < 1e-6 && (ta > t_start || start_on_top);
         if (h.top_face) h.point.z = zt;  // the face's height, not its rounding along the ray
         return h;
       }
