@@ -392,10 +392,11 @@ gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profi
   rc.ui.scale = profile.render.ui.scale;
   rc.ui.source = o.live.source;
   rc.ui.kiosk = o.kiosk;
-  // The program panel: --program, or the emulator's program file.
-  const std::string emu = o.live.source.rfind("emulator:", 0) == 0 ? o.live.source.substr(9) : "";
-  if (!o.live.program.empty()) rc.ui.program = app::program_text(o.live.program);
-  else if (!emu.empty() && emu != "demo") rc.ui.program = app::program_text(emu);
+  // The program panel: the emulator's program file (the one that runs), else --program.
+  const bool emulator = o.live.source.rfind("emulator:", 0) == 0;
+  const std::string emu = emulator ? o.live.source.substr(9) : "";
+  if (emulator && emu != "demo") rc.ui.program = app::program_text(emu);
+  else if (!emulator && !o.live.program.empty()) rc.ui.program = app::program_text(o.live.program);
   return rc;
 }
 
