@@ -196,6 +196,7 @@ std::size_t Geometry::tick(std::size_t limit) {
     if (s == nullptr) break;
     stream_.take(s->channel, s->seq, s->tool, s->q, s->mask);
     if (s->channel < hal::kMaxChannels) pending_[s->channel] = *s, pending_have_[s->channel] = true;
+    if (pos_ != nullptr) pos_->on_sample(*s);
     rx_[n] = s->t_rx_ns;
     weight_[n++] = 1 + s->coalesced;
     ring_.pop();

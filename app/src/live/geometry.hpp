@@ -28,6 +28,7 @@
 #include "geom/lbr_solid.hpp"
 #include "gfx/exchange.hpp"
 #include "hal/sample.hpp"
+#include "live/program_position.hpp"
 #include "motion/sample_stream.hpp"
 #include "motion/tool_table.hpp"
 #include "sched/latency_stats.hpp"
@@ -68,6 +69,8 @@ class Geometry final : public motion::SweepSink {
   // Estimated work of one sweep alone (cells it reaches + its sections).
   [[nodiscard]] double work_units(const geom::SweepRef& s) const noexcept;
 
+  // Every sample taken from the ring also goes to `pos` (the status bar's program position).
+  void set_program_position(ProgramPosition* pos) noexcept { pos_ = pos; }
   // Rendering: tip points go to the exchange's path buffer (no allocation).
   void set_exchange(gfx::SolidExchange* ex) noexcept { ex_ = ex; }
   // Publishes the solid to the render side between batches (never waits; see
@@ -133,6 +136,7 @@ class Geometry final : public motion::SweepSink {
   std::atomic<double> removed_{0.0};
   int ticks_since_volume_ = 0;
   gfx::SolidExchange* ex_ = nullptr;
+  ProgramPosition* pos_ = nullptr;
   std::int64_t last_rx_ns_ = 0;
   std::array<bool, hal::kMaxChannels> have_{}, pending_have_{};
   std::array<hal::AxisSample, hal::kMaxChannels> last_{}, pending_{};

@@ -10,13 +10,17 @@
 
 #include "app/profile.hpp"
 #include "hal/source.hpp"
+#include "nc/emulator.hpp"
 
 namespace lbr::app::live {
 
 // `skip`: resuming (app/snapshot.hpp), the emulator starts after its first `skip` samples
 // (they are computed, not paced); other sources ignore it (replay skips with SkipSink).
+// `emulator` (may be null): receives an emulator source's emulator, whose plan (line_at,
+// total_time_s) other threads may read while the HAL thread samples it.
 [[nodiscard]] std::unique_ptr<hal::Source> make_source(const Profile& profile, const std::string& spec, double speed,
-                                                      std::uint64_t skip = 0);
+                                                      std::uint64_t skip = 0,
+                                                      std::shared_ptr<const nc::Emulator>* emulator = nullptr);
 
 // Resuming a replay: drops the samples whose sequence number is at most `through` (they
 // are in the resumed solid) and forwards the rest. HAL thread; real-time safe.
