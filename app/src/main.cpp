@@ -331,7 +331,7 @@ struct RunOptions {
   app::LiveOptions live;
   bool quiet = false;
   // rendering (gfx/): a viewer window when a display exists, screenshots on request
-  bool no_window = false, hidden = false, no_tool = false, no_ui = false;
+  bool no_window = false, hidden = false, no_tool = false, no_ui = false, kiosk = false;
   int screenshot_every = 0;
   std::string screenshot_prefix;  // empty: OUT/frame-
   std::string view = "iso", color = "heat", size = "1280x800";
@@ -400,6 +400,12 @@ gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profi
   rc.ui.enabled = !o.no_ui && !o.hidden && !o.no_window;
   rc.ui.scale = profile.render.ui.scale;
   rc.ui.source = o.live.source;
+  rc.ui.kiosk = o.kiosk;
+  // The program panel: the emulator's program file (the one that runs), else --program.
+  const bool emulator = o.live.source.rfind("emulator:", 0) == 0;
+  const std::string emu = emulator ? o.live.source.substr(9) : "";
+  if (emulator && emu != "demo") rc.ui.program = app::program_text(emu);
+  else if (!emulator && !o.live.program.empty()) rc.ui.program = app::program_text(o.live.program);
   return rc;
 }
 
@@ -469,7 +475,7 @@ class HudNotice {
 app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profile, const app::StatusFn& status) {
   const gfx::RenderThreadConfig rc = live_render_config(o, profile);
   const bool visible = !o.hidden && !o.no_window;
-  gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source);
+  gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source, o.kiosk);
   gfx::SolidExchange ex(1 << 14);
   std::promise<std::unique_ptr<geom::LbrSolid>> initial;
   auto initial_ready = initial.get_future();
@@ -507,7 +513,7 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
     set_render_thread(&rt);
     notice.attach(&rt);
     if (visible) {
-      gfx::run_event_loop(win, rt, [&] { return !live_done.load(); });
+      gfx::run_event_loop(win, rt, [&] { return !live_done.load(); }, o.kiosk);
       if (!live_done.load() && rt.running()) {  // the window was closed: end the run, keep its results
         g_window_closed.store(true);
         g_stop.store(true);
@@ -712,6 +718,10 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_option("--source", ro.live.source,
                   "can:IFACE | serial:DEVICE | replay:LOGFILE | emulator:PROGRAM (PROGRAM 'demo' = bundled demo)")
       ->capture_default_str();
+  run->add_option("--program", ro.live.program,
+                  "The part program the machine runs (can, serial, replay sources): its current line is found from "
+                  "the sampled positions and its emulated time gives the progress")
+      ->check(CLI::ExistingFile);
   run->add_option("--stl", ro.stl, "Also write the final part as binary STL");
   run->add_option("--ply", ro.ply, "Also write the final part as binary PLY (with move ids)");
   run->add_option("--profile", ro.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
@@ -731,6 +741,7 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_flag("--no-window", ro.no_window, "Do not open the viewer even when a display exists");
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
   run->add_flag("--no-ui", ro.no_ui, "Hide the operator UI (status bar, view controls); the text HUD instead");
+  run->add_flag("--kiosk", ro.kiosk, "Full screen without decorations; quitting asks for a confirmation");
   run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "
                   "headless: xvfb-run -a)")->check(CLI::Range(0, 1000000));
   run->add_option("--screenshot-prefix", ro.screenshot_prefix,

@@ -11,21 +11,10 @@ namespace lbr::geom::detail {
 namespace {
 
 // Sections with at least this many vertices are cut to the region before a clip.
-constexpr std::size_t kCutSectionVertices = 64;
+constexpr std::size_t kCutSectionVertices = 16;
 
-// True when some edge of the closed contour has a box that meets b (conservative: the edge
-// may still miss b).
-bool edge_near(const Path& c, const Rect& b) noexcept {
-  for (std::size_t i = 0, j = c.size() - 1; i < c.size(); j = i++) {
-    const Point& p = c[i];
-    const Point& q = c[j];
-    if (std::max(p.X, q.X) < b.x0 || std::min(p.X, q.X) > b.x1 || std::max(p.Y, q.Y) < b.y0 || std::min(p.Y, q.Y) > b.y1)
-      continue;
-    return true;
-  }
-  return false;
-}
-
+// Margin of the box a clip path is cut to around the material it may touch [units].
+constexpr Coord kKeepMarginUnits = 16;
 
 // The sections whose box meets the cell's content (ws.selected) and the cell's polygons
 // whose box meets those sections (ws.touched); false when either is empty.
@@ -45,30 +34,13 @@ bool select_for_cell(const Cell& cell, const LevelSections& ls, SubtractWorkspac
   return !ws.touched.empty();
 }
 
-// Sections in the air: when no edge of the material comes near a section's box, the box
-// lies wholly inside or wholly outside the material, and one point decides which. A
-// section outside removes nothing and leaves the clip (the shank of a finishing tool over
-// already cleared levels). False when none is left: nothing changes.
+// Sections in the air (cover_of() is None: no material in the section's box) leave the
+// clip: the shank of a finishing tool over already cleared levels. False when none is left:
+// nothing changes.
 bool drop_sections_in_air(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws, SubtractStats& stats) {
   std::size_t kept = 0;
   for (std::uint32_t k : ws.selected) {
-    const Rect& b = ls.box[k];
-    bool near = false, inside = false;
-    const Point centre{b.x0 + (b.x1 - b.x0) / 2, b.y0 + (b.y1 - b.y0) / 2};
-    for (std::uint32_t p : ws.touched) {
-      const Polygon& poly = cell.polys[p];
-      if (!poly.bbox.intersects(b)) continue;
-      near = edge_near(poly.outer.pts, b);
-      for (std::size_t h = 0; !near && h < poly.holes.size(); ++h) near = edge_near(poly.holes[h].pts, b);
-      if (near) break;
-      if (ClipperLib::PointInPolygon(centre, poly.outer.pts) != 0) {
-        inside = true;
-        for (const Contour& h : poly.holes)
-          if (ClipperLib::PointInPolygon(centre, h.pts) != 0) inside = false;
-        if (inside) break;
-      }
-    }
-    if (near || inside) ws.selected[kept++] = k;
+    if (cover_of(cell, ls.box[k]) != RectCover::None) ws.selected[kept++] = k;
     else ++stats.sections_in_air;
   }
   ws.selected.resize(kept);
@@ -153,21 +125,34 @@ Rect SubtractEngine::grown_region_rect(int region) const noexcept {
   return Rect{rr.x0 - g, rr.y0 - g, rr.x1 + g, rr.y1 + g};
 }
 
-// The selected sections as clip paths. A chain enters as its offset's piece for the
-// region; a long section that reaches well beyond the region (a joined outline runs along
-// a whole pass) is cut down to the region grown by 1 mm first, so that the clip carries
-// only the nearby edges (the cut keeps the path inside the grown region, where the cell lies).
-void SubtractEngine::add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const {
+// The selected sections as clip paths, each cut down (cut_to_rect()) to the box of the
+// touched polygons grown by kKeepMarginUnits: the difference depends only on the part of a
+// section that meets the material, which lies strictly inside that box, and inside it the
+// cut changes no vertex and no winding number. A joined outline runs along a whole pass and
+// a finishing pass mostly over material already removed, so most of its edges (its caps
+// over cleared levels, the stretch beyond the material) leave the clip. A chain enters as its
+// offset's piece for the region, cut the same way.
+void SubtractEngine::add_clip_paths(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh,
+                                    SubtractWorkspace& ws) const {
   ClipperLib::Clipper& c = ws.clipper;
-  const Rect grown = grown_region_rect(region);
+  Rect keep;
+  for (std::uint32_t p : ws.touched) keep.add(cell.polys[p].bbox);
+  keep = Rect{keep.x0 - kKeepMarginUnits, keep.y0 - kKeepMarginUnits, keep.x1 + kKeepMarginUnits, keep.y1 + kKeepMarginUnits};
+  auto add = [&](const Path& path) {
+    if (path.size() < kCutSectionVertices || contains(keep, bounds_of(path))) {
+      c.AddPath(path, ClipperLib::ptClip, true);
+      return;
+    }
+    cut_to_rect(path, keep, ws.cut, ws.cut_tmp);
+    if (ws.cut.size() >= 3) c.AddPath(ws.cut, ClipperLib::ptClip, true);
+  };
   for (std::uint32_t k : ws.selected) {
     if (ls.chain[k] != kNoChain) {
-      c.AddPaths(offset_piece(sh, ls.chain[k], region, ws), ClipperLib::ptClip, true);
-    } else if (contains(grown, ls.box[k]) || ls.paths[k].size() < kCutSectionVertices) {
+      for (const Path& piece : offset_piece(sh, ls.chain[k], region, ws)) add(piece);
+    } else if (ls.paths[k].size() < kCutSectionVertices || contains(keep, ls.box[k])) {
       c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
     } else {
-      cut_to_rect(ls.paths[k], grown, ws.cut, ws.cut_tmp);
-      if (ws.cut.size() >= 3) c.AddPath(ws.cut, ClipperLib::ptClip, true);
+      add(ls.paths[k]);
     }
   }
 }
@@ -188,7 +173,7 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
     c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
     for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
   }
-  add_clip_paths(region, ls, sh, ws);
+  add_clip_paths(cell, region, ls, sh, ws);
   ws.tree.Clear();
   c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
   ++stats.cells_clipped;

@@ -72,7 +72,7 @@ class SubtractEngine {
                  SubtractStats& stats);                                                                    // D
 
   // --- cell_clip.cpp ---
-  void add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const;
+  void add_clip_paths(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const;
   bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                  SubtractStats& stats);
 

@@ -41,6 +41,10 @@ struct LiveProgress {
 
 struct LiveOptions {
   std::string source;     // can:IF | serial:DEV | replay:FILE | emulator:PROGRAM
+  // The program the machine runs (can, serial, replay): its line is found from the sampled
+  // positions (nc::LineTracker) and its emulated time is the run's total, for the status bar.
+  // Not used with an emulator source, which knows its line.
+  std::string program;
   double speed = 1.0;     // replay/emulator: 1 = real time, 0 = as fast as possible
   std::string record;     // write the raw input to this file (candump -l format; the emulator's
                           // samples as the serial frames of the profile's mapping)

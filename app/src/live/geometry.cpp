@@ -208,6 +208,7 @@ bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
       // One sweep over the budget: cut into pieces.
       if (!apply_pieces(batch[i], std::min(kMaxPieces, static_cast<int>(std::ceil(first / budget_))))) return false;
     } else {
+      j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
       kernel(batch.subspan(i, j - i));
     }
     i = j;
@@ -230,6 +231,7 @@ std::size_t Geometry::tick(std::size_t limit) {
     taken_ = n + 1;
     stream_.take(s->channel, s->seq, s->tool, s->q, s->mask);
     if (s->channel < hal::kMaxChannels) pending_[s->channel] = *s, pending_have_[s->channel] = true;
+    if (pos_ != nullptr) pos_->on_sample(*s);
     weight_[n++] = 1 + s->coalesced;
     ring_.pop();
   }

@@ -29,6 +29,7 @@
 #include "live/checks.hpp"
 #include "gfx/exchange.hpp"
 #include "hal/sample.hpp"
+#include "live/program_position.hpp"
 #include "motion/sample_stream.hpp"
 #include "motion/tool_table.hpp"
 #include "sched/latency_stats.hpp"
@@ -78,6 +79,8 @@ class Geometry final : public motion::SweepSink {
   // Duration of the checks before each kernel call.
   [[nodiscard]] const sched::LatencyHistogram& check_time() const noexcept { return check_; }
 
+  // Every sample taken from the ring also goes to `pos` (the status bar's program position).
+  void set_program_position(ProgramPosition* pos) noexcept { pos_ = pos; }
   // Rendering: tip points go to the exchange's path buffer (no allocation).
   void set_exchange(gfx::SolidExchange* ex) noexcept { ex_ = ex; }
   // Publishes the solid to the render side between batches (never waits; see
@@ -151,6 +154,7 @@ class Geometry final : public motion::SweepSink {
   std::atomic<double> removed_{0.0};
   int ticks_since_volume_ = 0;
   gfx::SolidExchange* ex_ = nullptr;
+  ProgramPosition* pos_ = nullptr;
   std::int64_t last_rx_ns_ = 0;
   std::array<bool, hal::kMaxChannels> have_{}, pending_have_{};
   std::array<hal::AxisSample, hal::kMaxChannels> last_{}, pending_{};

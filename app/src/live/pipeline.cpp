@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "app/live.hpp"
+#include "app/outputs.hpp"
 #include "geom/lbr_solid.hpp"
 #include "live/geometry.hpp"
 #include "live/ring_sink.hpp"
@@ -45,6 +46,8 @@ struct LivePipeline::Impl {
   hal::SampleSink* input = nullptr;            // what the source delivers to
   std::unique_ptr<Geometry> geo;
   std::unique_ptr<live::LiveChecks> checks;  // collision checks on the geometry thread (null: off)
+  std::shared_ptr<const nc::Emulator> emulator;        // an emulator source's (its plan)
+  std::unique_ptr<live::ProgramPosition> position;     // line, machining time for the status bar
   // Power-loss snapshots (app/snapshot.hpp): the writer, its period, and where a resumed
   // run started (the source's sample numbers restart at 1 after an emulator skip).
   std::unique_ptr<SnapshotWriter> snap;
@@ -111,6 +114,7 @@ gfx::LiveStats live_stats(const LivePipeline::Impl& p) {
   st.samples_held = p.sink->held();
   st.realtime = p.hal_mode.load(std::memory_order_relaxed) == 1 && p.geo_mode.load(std::memory_order_relaxed) == 1;
   if (p.checks) p.checks->fill_alarms(st);
+  if (p.position) p.position->fill(st);
   return st;
 }
 
@@ -326,6 +330,16 @@ void fill_check_results(const LivePipeline::Impl& p, LiveResult& r) {
   r.check_max_ms = ms(ct.max_ns());
 }
 
+// The status bar's program position: the emulator source's plan, or --program's moves.
+void configure_program(LivePipeline::Impl& p) {
+  std::optional<nc::Toolpath> program;
+  if (!p.opt.program.empty() && !p.emulator) program = load_toolpath(p.opt.program, p.profile);
+  p.position = std::make_unique<live::ProgramPosition>(p.emulator, program ? &*program : nullptr,
+                                                       live_emulator_limits(p.profile), p.profile.live.period_ms * 1e-3,
+                                                       p.seq_base);
+  p.geo->set_program_position(p.position.get());
+}
+
 geom::SolidSpec live_solid_spec(const Profile& profile, const motion::ToolTable& tools) {
   geom::SolidSpec spec = profile.solid;
   if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tools.max_diameter());
@@ -359,8 +373,7 @@ void LivePipeline::configure() {
   p.seq_base = resume != nullptr && emulator ? resume->source_position : 0;
   start_snapshots(p);
 
-  live::ProgramLines lines;
-  p.src = live::make_source(profile, p.opt.source, p.opt.speed, p.seq_base, &lines);
+  p.src = live::make_source(profile, p.opt.source, p.opt.speed, p.seq_base, &p.emulator);
   p.src->open();
   p.backpressure = !p.src->live();
   p.ring = std::make_unique<sched::SpscRing<hal::AxisSample>>(cfg.ring_capacity);
@@ -387,7 +400,8 @@ void LivePipeline::configure() {
   p.geo = std::make_unique<Geometry>(p.r->solid, profile, *p.tools, cfg.tool, *p.ring, cfg.merge_tolerance_mm);
   if (profile.checks.enabled) {
     p.checks = std::make_unique<live::LiveChecks>(profile, *p.tools, Geometry::batch_capacity(p.ring->capacity()),
-                                                  std::move(lines));
+                                                  live::ProgramLines(p.emulator, emulator ? p.opt.source.substr(9) : "",
+                                                                     p.seq_base));
     p.geo->set_checks(p.checks.get());
   }
   if (resume != nullptr && (emulator || replay)) {  // a live machine has moved on: no sweep across the outage
@@ -399,6 +413,7 @@ void LivePipeline::configure() {
   p.geo->set_kernel_delay_ns(p.opt.test_kernel_delay_ns);
   if (p.opt.test_work_budget > 0) p.geo->set_work_budget(p.opt.test_work_budget);
   p.geo->set_exchange(p.opt.exchange);
+  configure_program(p);
   if (p.opt.on_start) p.opt.on_start(p.r->solid);
   p.r->solid.clear_dirty();  // the render side starts from this state
 }
