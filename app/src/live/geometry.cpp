@@ -203,12 +203,12 @@ bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
     // The checks judge the sub-batch against the stock now; a sweep after the first that
     // meets material ends it (judged again, as the first of the next, once the ones before
     // it are subtracted).
+    j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
     j = checked(i, j);
     if (j == i + 1 && first > budget_) {
       // One sweep over the budget: cut into pieces.
       if (!apply_pieces(batch[i], std::min(kMaxPieces, static_cast<int>(std::ceil(first / budget_))))) return false;
     } else {
-      j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
       kernel(batch.subspan(i, j - i));
     }
     i = j;
