@@ -165,12 +165,13 @@ TEST(ProcessChecks, ACutAfterM5RaisesSpindleOffAtItsLine) {
   EXPECT_TRUE(good.events.empty()) << verify::describe(good.events.at(0));
   EXPECT_NEAR(good.removed_volume_mm3, bad.removed_volume_mm3, 1e-6);  // the check does not change the cut
 
-  // M3 without an S word: S0 from power-up, the spindle does not turn; the first cut (line 5)
-  // is reported, the rapid above the stock is not.
-  const app::BatchResult no_s = run("G21 G90 G17\nT1 M6 G43 H1\nM3\nG0 X-10 Y40 Z5\nG1 Z-2 F300\nG0 Z10\nM2\n");
+  // M3 without an S word: S0 from power-up, the spindle does not turn; the plunge (line 5)
+  // is reported with its cylinder, the moves above the stock are not.
+  const app::BatchResult no_s = run("G21 G90 G17\nT1 M6 G43 H1\nM3\nG0 X20 Y40 Z5\nG1 Z-2 F300\nG0 Z10\nM2\n");
   ASSERT_EQ(no_s.events.size(), 1u);
   EXPECT_EQ(no_s.events[0].kind, verify::EventKind::SpindleOff);
   EXPECT_EQ(no_s.events[0].line, 5);
+  EXPECT_NEAR(no_s.events[0].volume_mm3, std::numbers::pi * 25.0 * 2.0, 0.01 * 157.1);
   EXPECT_DOUBLE_EQ(no_s.events[0].value, 0.0);
 }
 
@@ -356,7 +357,7 @@ TEST(CheckProfile, TravelLimitsAndTheCentreCuttingFlagAreRead) {
   bad.replace(bad.find("[machine]\n"), 10, "[machine]\ntravel_min_mm = [0, 0, 0]\ntravel_max_mm = [10, 10, -1]\n");
   EXPECT_NE(error_of(bad).find("machine.travel_max_mm: expected every maximum above its minimum"), std::string::npos)
       << error_of(bad);
-  const std::string ball = app::default_profile_text() +
+  const std::string ball = std::string(app::default_profile_text()) +
                            "\n[[tool]]\nnumber = 6\nkind = \"ball\"\ndiameter_mm = 6.0\ncentre_cutting = false\n";
   EXPECT_NE(error_of(ball).find("tool.centre_cutting: only for tool kinds flat and bull"), std::string::npos)
       << error_of(ball);
