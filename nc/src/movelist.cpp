@@ -17,16 +17,6 @@ const char* to_string(SegmentKind k) noexcept {
   return "?";
 }
 
-const char* to_string(Spindle s) noexcept {
-  switch (s) {
-    case Spindle::Unknown: return "unknown";
-    case Spindle::Off: return "off";
-    case Spindle::Cw: return "cw";
-    case Spindle::Ccw: return "ccw";
-  }
-  return "?";
-}
-
 AxisVector machine_axes(const Toolpath& path, const AxisVector& tip, int tool) noexcept {
   AxisVector m{};
   for (int a = 0; a < kAxes; ++a) m[a] = tip[a] + path.machine_origin[a];

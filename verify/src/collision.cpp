@@ -75,12 +75,12 @@ int CollisionChecker::findings_of(const geom::LbrSolid& solid, const motion::Tim
   const auto parts = parts_.find(m.tool);
   const Parts* p = parts == parts_.end() ? nullptr : &parts->second;
   int n = 0;
-  if (const nc::Segment* seg = index_.find(m.ref.id, nullptr)) n = process_findings(solid, m, *seg, p, out, n);
+  if (const nc::Segment* seg = index_.find(m.ref.id, nullptr)) n = segment_findings(solid, m, *seg, out, n);
   return p != nullptr ? part_findings(solid, m, *p, out, n) : n;
 }
 
-int CollisionChecker::process_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const nc::Segment& seg,
-                                       const Parts* p, Findings& out, int n) {
+int CollisionChecker::segment_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const nc::Segment& seg,
+                                       Findings& out, int n) {
   const bool rapid = seg.kind == nc::SegmentKind::Rapid;
   const bool spindle_off = !seg.spindle_turning();
   const double feed_limit = config_.max_cutting_feed_mm_per_min;
@@ -93,18 +93,18 @@ int CollisionChecker::process_findings(const geom::LbrSolid& solid, const motion
       if (too_fast) out[n++] = {EventKind::FeedLimit, in, seg.feed_mm_per_min};
     }
   }
-  if (p != nullptr && !p->centre_cutting) {
-    const double angle = descent_deg(m.ref.from, m.ref.to);
-    if (angle > config_.max_ramp_angle_deg) {
-      const Intrusion in = probe_.measure(solid, geom::Sweep(p->core, m.ref.from, m.ref.to), config_.tolerance_mm);
-      if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
-    }
-  }
   return n;
 }
 
 int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const Parts& p,
                                     Findings& out, int n) {
+  if (!p.centre_cutting) {
+    const double angle = descent_deg(m.ref.from, m.ref.to);
+    if (angle > config_.max_ramp_angle_deg) {
+      const Intrusion in = probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to), config_.tolerance_mm);
+      if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
+    }
+  }
   if (p.has_shank) {
     const Intrusion in =
         probe_.measure(solid, geom::Sweep(p.shank, raised(m.ref.from, p.shank_from_mm), raised(m.ref.to, p.shank_from_mm)),

@@ -40,8 +40,6 @@ enum class PathControl : unsigned char {
 // words (move lists), so the process checks cannot judge it.
 enum class Spindle : unsigned char { Unknown, Off, Cw, Ccw };
 
-[[nodiscard]] const char* to_string(Spindle s) noexcept;  // "unknown", "off", "cw", "ccw"
-
 struct Segment {
   SegmentKind kind = SegmentKind::Feed;
   AxisVector end{};                       // axis positions at the end of the segment

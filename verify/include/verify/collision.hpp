@@ -100,11 +100,11 @@ class CollisionChecker {
   using Findings = Finding[kMaxFindings];
   // The findings of one move against `solid`; returns how many were written.
   int findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, Findings& out);
-  // Rapid, spindle-off and feed-limit (the cutting sweep) and the plunge (the core) of move
-  // `m` of segment `seg`, written from out[n]; returns the new count.
-  int process_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const nc::Segment& seg,
-                       const Parts* p, Findings& out, int n);
-  // Shank and holder, written from out[n]; returns the new count.
+  // Rapid, spindle-off and feed-limit (the cutting sweep; they need the move's program
+  // segment `seg`), written from out[n]; returns the new count.
+  int segment_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const nc::Segment& seg,
+                       Findings& out, int n);
+  // Plunge (the non-cutting core), shank and holder, written from out[n]; returns the new count.
   int part_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const Parts& p, Findings& out, int n);
   [[nodiscard]] Event event_of(const motion::TimedSweep& m, const Finding& f) const;
 
