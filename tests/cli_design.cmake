@@ -46,3 +46,9 @@ string(REGEX MATCH "^[0-9]+" gouge_mm3 "${gouge}")
 if(NOT removed_mm3 EQUAL gouge_mm3 OR excess GREATER 0.001 OR NOT EXISTS "${OUT}/run/deviation.csv")
   message(FATAL_ERROR "--design stock.stl: gouge ${gouge} mm3 (expected ${removed}), excess ${excess} mm3")
 endif()
+# The demo cuts that design deeply: one design-gouge error, so --fail-on error exits 3.
+execute_process(COMMAND "${LBRSIM}" batch --quiet --out "${OUT}/fail" --design "${OUT}/stock.stl" --fail-on error
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 3 OR NOT "${out}${err}" MATCHES "checks: 1 error,.*design-gouge")
+  message(FATAL_ERROR "--design stock.stl --fail-on error: exit ${rc} (expected 3): ${out} ${err}")
+endif()

@@ -179,7 +179,7 @@ TEST(LatheC, HexagonByG12_1PolarInterpolation) {
   const app::Profile p = app::parse_profile(kLatheCHexProfile, "hex.toml");
   // G7: X words are diameters of the Cartesian x; C words are the Cartesian y [mm].
   const std::string prog =
-      "G18 G7 G90 G21\nT1 M6\nG0 X80 Z5\nG0 X41.569219 C30\nG12.1\nG1 Z-5 F300\n"
+      "G18 G7 G90 G21\nT1 M6 S1000 M3\nG0 X80 Z5\nG0 X41.569219 C30\nG12.1\nG1 Z-5 F300\n"
       "G1 X36 C10.392305 F600\nG1 X0 C20.784610\nG1 X-36 C10.392305\nG1 X-36 C-10.392305\n"
       "G1 X0 C-20.784610\nG1 X36 C-10.392305\nG0 Z5\nG13.1\nG0 X80\n";
   const nc::Toolpath path = nc::interpret_gcode(prog, "hex.ngc", app::gcode_options(p));

@@ -241,6 +241,26 @@ TEST_F(Rs274CrossCheck, BundledCamProgramCoincides) {
   expect_same_path(run_rs274(path, o), load_gcode(path, o), 0.001);
 }
 
+// The spindle state (docs/nc-frontend.md#spindle) comes from both front ends alike: M5 S0 at
+// start, then what M3/M4/M5 and S set, on every segment.
+TEST_F(Rs274CrossCheck, SpindleStatesAgree) {
+  const GcodeOptions o = recorded_options(0.0005);
+  const std::string path = write("spindle.ngc", "G21 G90\nG0 X1\nS2000 M4\nG1 X2 F100\nM5\nG1 X3\nS500 M3\nG1 X4\nS0\nG1 X5\nM2\n");
+  const Toolpath theirs = run_rs274(path, o), mine = load_gcode(path, o);
+  ASSERT_EQ(mine.segments.size(), 5u);
+  ASSERT_EQ(theirs.segments.size(), mine.segments.size());
+  const Spindle expected[] = {Spindle::Off, Spindle::Ccw, Spindle::Off, Spindle::Cw, Spindle::Cw};
+  const double s_expected[] = {0, 2000, 2000, 500, 0};
+  for (std::size_t i = 0; i < mine.segments.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(mine.segments[i].spindle, expected[i]);
+    EXPECT_EQ(theirs.segments[i].spindle, expected[i]);
+    EXPECT_DOUBLE_EQ(mine.segments[i].spindle_s, s_expected[i]);
+    EXPECT_DOUBLE_EQ(theirs.segments[i].spindle_s, s_expected[i]);
+    EXPECT_EQ(mine.segments[i].spindle_turning(), i == 1 || i == 3);
+  }
+}
+
 TEST_F(Rs274CrossCheck, SubroutinesAndParametersAgree) {
   const std::string path = write("sub.ngc",
                                  "G21 G90\n"

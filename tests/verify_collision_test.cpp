@@ -26,6 +26,19 @@ app::BatchResult run(const std::string& program, int batch_moves = 512) {
   return app::run_batch(p, path);
 }
 
+app::BatchResult run(const app::Profile& profile, const std::string& program) {
+  app::Profile p = profile;
+  p.threads = 1;
+  const nc::Toolpath path = nc::interpret_gcode(program, "t.ngc", app::gcode_options(p));
+  return app::run_batch(p, path);
+}
+
+const verify::Event* first_of(const std::vector<verify::Event>& ev, verify::EventKind k) {
+  for (const verify::Event& e : ev)
+    if (e.kind == k) return &e;
+  return nullptr;
+}
+
 std::size_t count_kind(const std::vector<verify::Event>& ev, verify::EventKind k) {
   std::size_t n = 0;
   for (const verify::Event& e : ev) n += e.kind == k ? 1 : 0;
@@ -67,7 +80,7 @@ TEST(IntrusionProbe, AGrazeWithinTheMarginIsNotDeep) {
 
 TEST(CollisionChecks, ARapidThroughTheStockIsReportedWithItsVolume) {
   const app::BatchResult r = run(
-      "G21 G90\nT1 M6 G43 H1\nG0 X-10 Y40 Z10\nG0 Z-5\nG0 X110\nG0 Z10\nM2\n");
+      "G21 G90\nT1 M6 G43 H1 S1000 M3\nG0 X-10 Y40 Z10\nG0 Z-5\nG0 X110\nG0 Z10\nM2\n");
   ASSERT_EQ(r.events.size(), 1u);
   const verify::Event& e = r.events[0];
   EXPECT_EQ(e.kind, verify::EventKind::RapidIntoMaterial);
@@ -84,14 +97,14 @@ TEST(CollisionChecks, ARapidThroughASlotCutEarlierInTheSameBatchIsClean) {
   // The feed cuts the slot; the rapid returns through it. Both are in one kernel batch, so
   // the checker must judge the rapid against the stock after the feed, not before the batch.
   const app::BatchResult r = run(
-      "G21 G90\nT1 M6 G43 H1\nG0 X-10 Y40 Z10\nG0 Z-5\nG1 X110 F600\nG0 X-10\nG0 Z10\nM2\n");
+      "G21 G90\nT1 M6 G43 H1 S1000 M3\nG0 X-10 Y40 Z10\nG0 Z-5\nG1 X110 F600\nG0 X-10\nG0 Z10\nM2\n");
   EXPECT_TRUE(r.events.empty()) << verify::describe(r.events.at(0));
   EXPECT_NEAR(r.removed_volume_mm3, 5000.0, 0.01 * 5000.0);
 }
 
 TEST(CollisionChecks, AForgottenG43PutsShankAndHolderIntoTheStockAtTheRightLine) {
   const std::string body = "G0 X20 Y20 Z5\nG1 Z-3 F300\nG1 X80 F600\nG1 Y60\nG0 Z20\nM2\n";
-  const app::BatchResult bad = run("G21 G90 G17\nT1 M6\n" + body);
+  const app::BatchResult bad = run("G21 G90 G17\nT1 M6 S1000 M3\n" + body);
   ASSERT_FALSE(bad.events.empty());
   // Without G43 the tip is 60 mm below the programmed Z: the flutes (30 mm) reach from the
   // tip to Z-25 at line 3, the shank from there to Z5 through the 30 mm box.
@@ -105,7 +118,7 @@ TEST(CollisionChecks, AForgottenG43PutsShankAndHolderIntoTheStockAtTheRightLine)
   }
   EXPECT_GE(verify::count(bad.events).errors, 2u);
 
-  const app::BatchResult good = run("G21 G90 G17\nT1 M6 G43 H1\n" + body);
+  const app::BatchResult good = run("G21 G90 G17\nT1 M6 G43 H1 S1000 M3\n" + body);
   EXPECT_TRUE(good.events.empty());
 }
 
@@ -117,7 +130,7 @@ TEST(CollisionChecks, TheBundledDemoIsClean) {
 }
 
 TEST(CollisionChecks, DisabledChecksReportNothingAndCutTheSame) {
-  const std::string prog = "G21 G90\nT1 M6 G43 H1\nG0 X-10 Y40 Z10\nG0 Z-5\nG0 X110\nG0 Z10\nM2\n";
+  const std::string prog = "G21 G90\nT1 M6 G43 H1 S1000 M3\nG0 X-10 Y40 Z10\nG0 Z-5\nG0 X110\nG0 Z10\nM2\n";
   app::Profile p = app::default_profile();
   p.threads = 1;
   const nc::Toolpath path = nc::interpret_gcode(prog, "t.ngc", app::gcode_options(p));
@@ -127,6 +140,141 @@ TEST(CollisionChecks, DisabledChecksReportNothingAndCutTheSame) {
   EXPECT_EQ(on.events.size(), 1u);
   EXPECT_TRUE(off.events.empty());
   EXPECT_DOUBLE_EQ(on.removed_volume_mm3, off.removed_volume_mm3);
+}
+
+// ---- process checks: spindle, plunge, feed, travel ----------------------------------------
+
+// A D10 slot 2 deep from X30 to X60 after the spindle stopped at line 7: the new material is
+// 30 x 10 x 2 = 600 mm3 (the half circles at both ends cancel).
+TEST(ProcessChecks, ACutAfterM5RaisesSpindleOffAtItsLine) {
+  const std::string head = "G21 G90 G17\nT1 M6 G43 H1\nS1000 M3\nG0 X-10 Y40 Z5\nG1 Z-2 F300\nG1 X30 F600\n";
+  const app::BatchResult bad = run(head + "M5\nG1 X60\nG0 Z10\nM2\n");
+  ASSERT_EQ(bad.events.size(), 1u) << verify::describe(bad.events.at(0));
+  const verify::Event& e = bad.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::SpindleOff);
+  EXPECT_EQ(e.severity(), verify::Severity::Error);
+  EXPECT_EQ(e.line, 8);
+  EXPECT_EQ(e.tool, 1);
+  EXPECT_NEAR(e.volume_mm3, 600.0, 0.01 * 600.0);
+  EXPECT_NEAR(e.depth_mm, 2.0, 1e-9);
+  EXPECT_NEAR(e.position.x, 60.0, 1e-9);
+  EXPECT_DOUBLE_EQ(e.value, 1000.0);  // S stays set; M5 stopped it
+
+  // The same program with the spindle running throughout raises nothing.
+  const app::BatchResult good = run(head + "G1 X60\nG0 Z10\nM2\n");
+  EXPECT_TRUE(good.events.empty()) << verify::describe(good.events.at(0));
+  EXPECT_NEAR(good.removed_volume_mm3, bad.removed_volume_mm3, 1e-6);  // the check does not change the cut
+
+  // M3 without an S word: S0 from power-up, the spindle does not turn; the plunge (line 5)
+  // is reported with its cylinder, the moves above the stock are not.
+  const app::BatchResult no_s = run("G21 G90 G17\nT1 M6 G43 H1\nM3\nG0 X20 Y40 Z5\nG1 Z-2 F300\nG0 Z10\nM2\n");
+  ASSERT_EQ(no_s.events.size(), 1u);
+  EXPECT_EQ(no_s.events[0].kind, verify::EventKind::SpindleOff);
+  EXPECT_EQ(no_s.events[0].line, 5);
+  EXPECT_NEAR(no_s.events[0].volume_mm3, std::numbers::pi * 25.0 * 2.0, 0.01 * 157.1);
+  EXPECT_DOUBLE_EQ(no_s.events[0].value, 0.0);
+}
+
+TEST(ProcessChecks, TheSpindleStateIsCarriedOnEverySegment) {
+  const nc::Toolpath path = nc::interpret_gcode("G21 G90\nG0 X1\nS2000 M4\nG1 X2 F100\nM5\nG1 X3\n", "s.ngc",
+                                                app::gcode_options(app::default_profile()));
+  ASSERT_EQ(path.segments.size(), 3u);
+  EXPECT_EQ(path.segments[0].spindle, nc::Spindle::Off);  // power-up M5 S0
+  EXPECT_FALSE(path.segments[0].spindle_turning());
+  EXPECT_EQ(path.segments[1].spindle, nc::Spindle::Ccw);
+  EXPECT_DOUBLE_EQ(path.segments[1].spindle_s, 2000.0);
+  EXPECT_TRUE(path.segments[1].spindle_turning());
+  EXPECT_EQ(path.segments[2].spindle, nc::Spindle::Off);
+  EXPECT_FALSE(path.segments[2].spindle_turning());
+}
+
+// T1 (flat D10) made non-centre-cutting: its non-cutting core is D2.5 (a quarter).
+TEST(ProcessChecks, ANonCentreCuttingToolPlungingIsReportedRampingGentlyIsNot) {
+  app::Profile p = app::default_profile();
+  p.tooling.tools[1].centre_cutting = false;
+  const std::string head = "G21 G90 G17\nT1 M6 G43 H1 S1000 M3\n";
+  const app::BatchResult plunge = run(p, head + "G0 X50 Y40 Z5\nG1 Z-3 F100\nG0 Z10\nM2\n");
+  ASSERT_EQ(plunge.events.size(), 1u) << verify::describe(plunge.events.at(0));
+  const verify::Event& e = plunge.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::Plunge);
+  EXPECT_EQ(e.severity(), verify::Severity::Error);
+  EXPECT_EQ(e.line, 4);
+  EXPECT_NEAR(e.value, 90.0, 1e-9);
+  const double core_mm3 = std::numbers::pi * 1.25 * 1.25 * 3.0;  // the core's cylinder 3 mm into the stock
+  EXPECT_NEAR(e.volume_mm3, core_mm3, 0.01 * core_mm3);
+  EXPECT_NEAR(e.depth_mm, 3.0, 1e-9);
+
+  // A 1.9 deg ramp (2 mm down over 60 mm) and the flat pass back: within the 3 deg limit.
+  const app::BatchResult ramp = run(p, head + "G0 X10 Y40 Z1\nG1 X70 Z-1 F300\nG1 X10\nG0 Z10\nM2\n");
+  EXPECT_TRUE(ramp.events.empty()) << verify::describe(ramp.events.at(0));
+  EXPECT_GT(ramp.removed_volume_mm3, 500.0);
+  // A 10 deg ramp is a plunge, reported with its angle.
+  const double steep_deg = std::atan2(3.5, 20.0) * 180.0 / std::numbers::pi;
+  const app::BatchResult steep = run(p, head + "G0 X20 Y40 Z0.5\nG1 X40 Z-3 F300\nG0 Z10\nM2\n");
+  ASSERT_EQ(steep.events.size(), 1u);
+  EXPECT_EQ(steep.events[0].kind, verify::EventKind::Plunge);
+  EXPECT_NEAR(steep.events[0].value, steep_deg, 1e-6);
+  // The same plunge with a centre-cutting T1 is fine.
+  EXPECT_TRUE(run(head + "G0 X50 Y40 Z5\nG1 Z-3 F100\nG0 Z10\nM2\n").events.empty());
+}
+
+TEST(ProcessChecks, APlungeIntoAPilotHoleWiderThanTheCoreIsClean) {
+  app::Profile p = app::default_profile();
+  p.tooling.tools[1].centre_cutting = false;
+  // T3 drills D8 to Z-5 (its 118 deg point: Z-4.25 at the core's radius 1.25); T1 then plunges to Z-4.
+  const app::BatchResult r = run(p,
+                                 "G21 G90 G17\nT3 M6 G43 H3 S1000 M3\nG0 X50 Y40 Z5\nG1 Z-5 F100\nG0 Z10\n"
+                                 "T1 M6 G43 H1\nG0 X50 Y40 Z5\nG1 Z-4 F100\nG0 Z10\nM2\n");
+  EXPECT_TRUE(r.events.empty()) << verify::describe(r.events.at(0));
+}
+
+TEST(ProcessChecks, AFeedOverTheLimitWhileCuttingIsAWarningWithItsFeed) {
+  app::Profile p = app::default_profile();
+  p.checks.max_cutting_feed_mm_per_min = 1000.0;
+  // F3000 in the air (line 4) is not cutting; F600 cuts within the limit; F1500 cuts over it.
+  const app::BatchResult r = run(p,
+                                 "G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X-10 Y40 Z5\nG1 X-8 F3000\n"
+                                 "G1 Z-2 F300\nG1 X30 F600\nG1 X60 F1500\nG0 Z10\nM2\n");
+  ASSERT_EQ(r.events.size(), 1u) << verify::describe(r.events.at(0));
+  const verify::Event& e = r.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::FeedLimit);
+  EXPECT_EQ(e.severity(), verify::Severity::Warning);
+  EXPECT_EQ(e.line, 7);
+  EXPECT_DOUBLE_EQ(e.value, 1500.0);
+  EXPECT_NEAR(e.volume_mm3, 600.0, 0.01 * 600.0);
+  const verify::EventCounts c = verify::count(r.events);
+  EXPECT_EQ(c.errors, 0u);
+  EXPECT_EQ(c.warnings, 1u);
+}
+
+// Default profile: G54 origin at machine Z-250, T1 60 mm long, so the gauge line is at
+// machine X = x, Z = z - 250 + 60 for the tip at (x, z).
+TEST(ProcessChecks, AMoveBeyondAnAxisLimitRaisesOverTravelWithAxisAndExcess) {
+  app::Profile p = app::default_profile();
+  p.machine.travel_min = {-5, -5, -300, -360, -360, -360};
+  p.machine.travel_max = {150, 100, -150, 360, 360, 360};
+  const app::BatchResult r = run(p,
+                                 "G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X-12 Y40 Z20\nG0 X-12 Y50\nG0 X50\n"
+                                 "G0 Z50\nG0 Z10\nM2\n");
+  ASSERT_EQ(r.events.size(), 2u);
+  const verify::Event* x = first_of(r.events, verify::EventKind::OverTravel);
+  ASSERT_NE(x, nullptr);
+  EXPECT_EQ(x->severity(), verify::Severity::Error);
+  EXPECT_EQ(verify::axis_name(x->axis), "X");
+  EXPECT_NEAR(x->value, 7.0, 1e-9);  // X-12 against -5
+  EXPECT_EQ(x->line, 3);
+  EXPECT_EQ(x->last_line, 4);  // one event for the two moves out there
+  EXPECT_EQ(x->moves, 2u);
+  const verify::Event& z = r.events[1];
+  EXPECT_EQ(z.kind, verify::EventKind::OverTravel);
+  EXPECT_EQ(verify::axis_name(z.axis), "Z");
+  EXPECT_NEAR(z.value, 10.0, 1e-9);  // 50 - 250 + 60 = -140 against -150
+  EXPECT_EQ(z.line, 6);
+  EXPECT_NEAR(z.position.z, 50.0, 1e-9);
+  const std::string csv = verify::events_csv(r.events);
+  EXPECT_NE(csv.find(",X,7.0000\n"), std::string::npos) << csv;
+  // Within the limits: nothing.
+  EXPECT_TRUE(run(p, "G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X0 Y40 Z20\nG0 X50\nM2\n").events.empty());
 }
 
 TEST(Events, ConsecutiveMovesOfOneKindAreOneEvent) {
@@ -170,13 +318,47 @@ TEST(Events, CsvHasOneLinePerEventAndQuotesSources) {
 
 TEST(CheckProfile, KeysAreReadAndTyposRejected) {
   const std::string base = app::default_profile_text();
-  const app::Profile p = app::parse_profile(base + "\n[checks]\nenabled = false\ntolerance_mm = 0.05\n", "c.toml");
+  const app::Profile p = app::parse_profile(base + "\n[checks]\nenabled = false\ntolerance_mm = 0.05\n"
+                                                   "max_cutting_feed_mm_per_min = 2500\nmax_ramp_angle_deg = 5\n",
+                                            "c.toml");
   EXPECT_FALSE(p.checks.enabled);
   EXPECT_DOUBLE_EQ(p.checks.tolerance_mm, 0.05);
+  EXPECT_DOUBLE_EQ(p.checks.max_cutting_feed_mm_per_min, 2500.0);
+  EXPECT_DOUBLE_EQ(p.checks.max_ramp_angle_deg, 5.0);
   try {
     (void)app::parse_profile(base + "\n[checks]\ntolerance = 0.05\n", "c.toml");
     FAIL() << "unknown key accepted";
   } catch (const app::ProfileError& e) {
     EXPECT_NE(std::string(e.what()).find("checks.tolerance"), std::string::npos) << e.what();
   }
+}
+
+TEST(CheckProfile, TravelLimitsAndTheCentreCuttingFlagAreRead) {
+  std::string text = app::default_profile_text();
+  text.replace(text.find("[machine]\n"), 10,
+               "[machine]\ntravel_min_mm = [-5, -10, -400]\ntravel_max_mm = [600, 400, 0]\ntravel_max_deg = [0, 0, 90]\n");
+  text += "\n[[tool]]\nnumber = 6\nkind = \"flat\"\ndiameter_mm = 16.0\ncentre_cutting = false\n";
+  const app::Profile p = app::parse_profile(text, "t.toml");
+  EXPECT_DOUBLE_EQ(p.machine.travel_min[nc::X], -5.0);
+  EXPECT_DOUBLE_EQ(p.machine.travel_max[nc::Z], 0.0);
+  EXPECT_DOUBLE_EQ(p.machine.travel_max[nc::C], 90.0);
+  EXPECT_TRUE(std::isinf(p.machine.travel_min[nc::A]));  // not given: unlimited
+  EXPECT_FALSE(p.tooling.tools.at(6).centre_cutting);
+  EXPECT_TRUE(p.tooling.tools.at(1).centre_cutting);
+  auto error_of = [](const std::string& t) {
+    try {
+      (void)app::parse_profile(t, "t.toml");
+    } catch (const app::ProfileError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string bad = app::default_profile_text();
+  bad.replace(bad.find("[machine]\n"), 10, "[machine]\ntravel_min_mm = [0, 0, 0]\ntravel_max_mm = [10, 10, -1]\n");
+  EXPECT_NE(error_of(bad).find("machine.travel_max_mm: expected every maximum above its minimum"), std::string::npos)
+      << error_of(bad);
+  const std::string ball = std::string(app::default_profile_text()) +
+                           "\n[[tool]]\nnumber = 6\nkind = \"ball\"\ndiameter_mm = 6.0\ncentre_cutting = false\n";
+  EXPECT_NE(error_of(ball).find("tool.centre_cutting: only for tool kinds flat and bull"), std::string::npos)
+      << error_of(ball);
 }

@@ -24,7 +24,7 @@ namespace {
 // run from X-10 to X110 (the tool outside the stock at both ends). Line 8 + 2i is pass i's
 // cutting move; the last pass cuts on line 20.
 std::string slot_program(double last_y = 55.0) {
-  std::string s = "G21 G90 G17\nT1 M6\nG43 H1\nG0 X-10 Y25 Z5\nG1 Z-5 F1000\nG1 Y25\n";
+  std::string s = "G21 G90 G17\nT1 M6 S1000 M3\nG43 H1\nG0 X-10 Y25 Z5\nG1 Z-5 F1000\nG1 Y25\n";
   for (int i = 0; i < 7; ++i) {
     const double y = i == 6 ? last_y : 25.0 + 5.0 * i;
     const char* x = i % 2 == 0 ? "X110" : "X-10";
@@ -125,6 +125,7 @@ TEST(DesignCompare, AnExactCutLeavesNoGougeAndNoExcess) {
   EXPECT_LT(d.max_gouge_mm, 0.005);
   EXPECT_LT(d.excess_mm3, 1.0);
   EXPECT_NEAR(r.removed_volume_mm3, 100.0 * 40.0 * 5.0, 1.0);
+  EXPECT_TRUE(r.events.empty()) << verify::describe(r.events.at(0));  // no gouge event, no process event
 }
 
 TEST(DesignCompare, AnOverCutPassIsMeasuredAndLocated) {
@@ -140,6 +141,15 @@ TEST(DesignCompare, AnOverCutPassIsMeasuredAndLocated) {
   EXPECT_EQ(d.gouge_line, 20);
   EXPECT_EQ(d.gouge_source, "slot.ngc");
   EXPECT_LT(d.excess_mm3, 1.0);
+  // The gouge is deeper than the 0.02 mm tolerance: one design-gouge error (--fail-on error exits 3).
+  ASSERT_EQ(r.events.size(), 1u);
+  const verify::Event& e = r.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::DesignGouge);
+  EXPECT_EQ(e.severity(), verify::Severity::Error);
+  EXPECT_EQ(e.line, 20);
+  EXPECT_EQ(e.tool, 1);
+  EXPECT_DOUBLE_EQ(e.depth_mm, d.max_gouge_mm);
+  EXPECT_DOUBLE_EQ(e.volume_mm3, d.gouge_mm3);
   ASSERT_FALSE(d.levels.empty());
   EXPECT_EQ(d.levels.size(), 50u);  // the 50 levels of the pocket's depth
   const std::string csv = verify::deviation_csv(d);

@@ -117,6 +117,13 @@ void compare_design(const Profile& profile, const std::vector<geom::Paths>& desi
   r.design = verify::compare_design(design, r.solid, profile.design.tolerance_mm);
   verify::attribute_gouge(*r.design, r.solid, moves, index);
   r.design_sections = design;
+  if (auto e = verify::gouge_event(*r.design, profile.design.tolerance_mm)) r.events.push_back(std::move(*e));
+}
+
+// over-travel: from the tool path alone, before the cut (its events come first).
+void check_travel(const Profile& profile, const nc::Toolpath& path, int channel, geom::MoveId base, BatchResult& r) {
+  if (profile.checks.enabled)
+    verify::check_travel(path, profile.machine.travel_min, profile.machine.travel_max, channel, base, r.events);
 }
 
 }  // namespace
@@ -172,6 +179,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
   motion::path_sweeps(tools, profile.kin, path, nullptr, 0, 0, moves, r.moves);
   verify::MoveIndex index;
   index.add(path, 0);
+  check_travel(profile, path, 0, 0, r);
   const std::vector<geom::Paths> design = design_sections(profile, r.solid);
   verify::CollisionChecker checker(profile.checks, tools, index);
   run_moves(profile, moves, r, progress, profile.checks.enabled ? &checker : nullptr);
@@ -190,9 +198,11 @@ BatchResult run_batch_channels(const Profile& profile, const std::vector<Channel
   r.moves = plan.moves;
   verify::MoveIndex index;  // segment ids of each channel (sampled: sample ids, no lines)
   geom::MoveId base = 0;
-  for (const ChannelPath& c : channels) {
-    if (!sampled) index.add(c.path, base);
-    base += static_cast<geom::MoveId>(c.path.segments.size());
+  for (std::size_t k = 0; k < channels.size(); ++k) {
+    const nc::Toolpath& path = channels[k].path;
+    if (!sampled) index.add(path, base);
+    check_travel(profile, path, static_cast<int>(k), base, r);
+    base += static_cast<geom::MoveId>(path.segments.size());
   }
   const std::vector<geom::Paths> design = design_sections(profile, r.solid);
   verify::CollisionChecker checker(profile.checks, tools, index);

@@ -51,7 +51,9 @@ nc::Toolpath load_toolpath(const std::string& path_as_given, const Profile& prof
   if (ext == ".moves") {
     if (interpreter == Interpreter::Rs274)
       throw std::runtime_error(path + ": --interpreter rs274 applies to G-code programs, not move lists");
-    return nc::load_movelist(path);
+    nc::Toolpath moves = nc::load_movelist(path);
+    nc::set_machine_frame(moves, gcode_options(profile));
+    return moves;
   }
   if (is_gcode_path(path)) {
     const nc::GcodeOptions o = gcode_options(profile);
@@ -117,7 +119,9 @@ nlohmann::json events_json(const std::vector<verify::Event>& events) {
                  {"position_mm", {e.position.x, e.position.y, e.position.z}},
                  {"volume_mm3", e.volume_mm3},
                  {"depth_mm", e.depth_mm},
-                 {"region", e.region}});
+                 {"region", e.region},
+                 {"axis", verify::axis_name(e.axis)},
+                 {"value", e.value}});
   }
   return a;
 }

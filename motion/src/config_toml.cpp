@@ -58,6 +58,10 @@ geom::Tool read_cutter(cfg::Table& s, kin::Mount& mount) {
   t.shank_diameter_mm = s.number("shank_diameter_mm", t.diameter_mm, 0.0, 1000.0, "mm");
   t.holder_diameter_mm = s.number("holder_diameter_mm", 40.0, 0.0, 1000.0, "mm");
   t.holder_length_mm = s.number("holder_length_mm", 40.0, 0.0, 5000.0, "mm");
+  const bool end_mill = t.kind == geom::ToolKind::Flat || t.kind == geom::ToolKind::Bull;
+  if (!end_mill && s.peek("centre_cutting") != nullptr)
+    s.fail(s.peek("centre_cutting"), "centre_cutting", "only for tool kinds flat and bull (ball, drill and vbit tools cut at the centre)");
+  t.centre_cutting = s.boolean("centre_cutting", true);
   if (t.kind == geom::ToolKind::Bull) t.corner_radius_mm = s.required_number("corner_radius_mm", 0.0, 500.0, "mm");
   if (t.kind == geom::ToolKind::Drill) t.angle_deg = s.number("point_angle_deg", 118.0, 1.0, 179.0, "deg");
   if (t.kind == geom::ToolKind::VBit) t.angle_deg = s.required_number("included_angle_deg", 1.0, 179.0, "deg");

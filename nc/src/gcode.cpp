@@ -437,6 +437,7 @@ class Interpreter {
     set_feed_and_speed(b, k);
     change_tools(b, k);
     if (k.mspindle != nullptr) spindle_ = static_cast<int>(k.mspindle->value);
+    stamp_spindle();
     if (k.mcool != nullptr) coolant_ = static_cast<int>(k.mcool->value);
     if (k.dwell != 0) {
       if (!has(b, 'P') && !fanuc_) fail("'G4' needs P (dwell time [s])");
@@ -637,6 +638,12 @@ class Interpreter {
     retract_to_initial_ = m.retract_initial, path_mode_ = m.path_mode, spindle_ = m.spindle, coolant_ = m.coolant;
     plane_ = m.plane;
     if (m.wcs != wcs_) select_wcs(m.wcs);
+    stamp_spindle();
+  }
+
+  // The spindle state the segments from here on carry (M3/M4/M5 and S; G96: the surface speed).
+  void stamp_spindle() {
+    b_.set_spindle(spindle_ == 3 ? Spindle::Cw : spindle_ == 4 ? Spindle::Ccw : Spindle::Off, spindle_rpm_);
   }
 
   // A subroutine returns: M73 state saved in it is restored; its saved states end with it.
@@ -1410,7 +1417,7 @@ class Interpreter {
   int motion_ = -1;  // code x 10; -1: none (G80 or program start)
   double feed_ = 0.0;
   double spindle_rpm_ = 0.0;
-  int spindle_ = 5;  // M3, M4 or M5 (recorded, not in the Toolpath)
+  int spindle_ = 5;  // M3, M4 or M5 (stamped on the segments: stamp_spindle())
   int coolant_ = 9;  // M7, M8 or M9 (recorded, not in the Toolpath)
   int selected_tool_ = 0;
   int pauses_ = 0;

@@ -17,6 +17,14 @@ const char* to_string(SegmentKind k) noexcept {
   return "?";
 }
 
+AxisVector machine_axes(const Toolpath& path, const AxisVector& tip, int tool) noexcept {
+  AxisVector m{};
+  for (int a = 0; a < kAxes; ++a) m[a] = tip[a] + path.machine_origin[a];
+  const auto it = path.tool_lengths_mm.find(tool);
+  if (it != path.tool_lengths_mm.end()) m[Z] += it->second;
+  return m;
+}
+
 namespace {
 
 std::vector<std::string> split_words(const std::string& line) {

@@ -33,6 +33,7 @@ PathBuilder::PathBuilder(const std::string& source, const GcodeOptions& options)
   pos_ = from_machine(options.start_machine);
   tp_.start = tip(pos_);
   tp_.start_tool = tool_;
+  set_machine_frame(tp_, options);
 }
 
 double PathBuilder::tool_length(int tool) const {
@@ -72,6 +73,8 @@ void PathBuilder::push(SegmentKind k, int line, const AxisVector& end_program, d
   s.path_control = control_;
   s.blend_tol_mm = blend_tol_mm_;
   s.naive_tol_mm = naive_tol_mm_;
+  s.spindle = spindle_;
+  s.spindle_s = spindle_s_;
   tp_.segments.push_back(s);
 }
 
@@ -160,3 +163,12 @@ void PathBuilder::tool_change(int line, int tool) {
 }
 
 }  // namespace lbr::nc::detail
+
+namespace lbr::nc {
+
+void set_machine_frame(Toolpath& path, const GcodeOptions& options) {
+  path.machine_origin = options.work_offsets[0];
+  path.tool_lengths_mm = options.tool_lengths;
+}
+
+}  // namespace lbr::nc

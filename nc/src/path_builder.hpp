@@ -63,6 +63,8 @@ class PathBuilder {
   void set_path_control(PathControl c, double blend_tol_mm, double naive_tol_mm) {
     control_ = c, blend_tol_mm_ = blend_tol_mm, naive_tol_mm_ = naive_tol_mm;
   }
+  // Spindle state stamped on the segments that follow (M3/M4/M5, S; docs/nc-frontend.md#spindle).
+  void set_spindle(Spindle state, double s) { spindle_ = state, spindle_s_ = s; }
   void dwell(int line, double seconds);
   void tool_change(int line, int tool);
 
@@ -84,6 +86,8 @@ class PathBuilder {
   // measured to do (docs/nc-frontend.md#planner); an explicit G64 without P has no P bound.
   PathControl control_ = PathControl::Blend;
   double blend_tol_mm_ = kPowerUpBlendTolMm, naive_tol_mm_ = 0.0;
+  Spindle spindle_ = Spindle::Off;  // LinuxCNC powers up with M5 S0
+  double spindle_s_ = 0.0;
 };
 
 }  // namespace lbr::nc::detail

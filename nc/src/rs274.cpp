@@ -293,6 +293,10 @@ class CanonReader {
       per_rev_ = std::lround(args(c, 1).back()) == 1;
     } else if (cmd == "SET_SPINDLE_SPEED") {
       spindle_s_ = args(c, 2)[1];
+      b_.set_spindle(spindle_, spindle_s_);
+    } else if (cmd == "START_SPINDLE_CLOCKWISE" || cmd == "START_SPINDLE_COUNTERCLOCKWISE" || cmd == "STOP_SPINDLE_TURNING") {
+      spindle_ = cmd == "STOP_SPINDLE_TURNING" ? Spindle::Off : cmd == "START_SPINDLE_CLOCKWISE" ? Spindle::Cw : Spindle::Ccw;
+      b_.set_spindle(spindle_, spindle_s_);
     } else if (cmd == "SET_SPINDLE_MODE") {  // (spindle max): max > 0 is G96 with that cap (1e30: none)
       const double max = args(c, 2, 1e31)[1];
       css_ = max > 0.0;
@@ -330,6 +334,7 @@ class CanonReader {
   bool per_rev_ = false;
   double spindle_s_ = 0.0, css_max_rpm_ = 0.0, sync_k_ = 0.0;  // S [rpm or surface speed], G96 cap, K [mm/rev]
   bool css_ = false;
+  Spindle spindle_ = Spindle::Off;  // M5 at start, as LinuxCNC powers up
   int selected_ = 0;
   PathControl path_ = PathControl::Blend;
   double path_p_mm_ = 0.0, path_q_mm_ = 0.0;

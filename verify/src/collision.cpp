@@ -1,6 +1,8 @@
 #include "verify/collision.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 
 namespace lbr::verify {
 
@@ -21,6 +23,16 @@ geom::CutterShape cylinder(double diameter_mm, double length_mm, double chord_to
   t.length_mm = length_mm;
   t.shank_diameter_mm = diameter_mm;
   return geom::CutterShape::build(t, chord_tol_mm);
+}
+
+// The angle of the tip's descent along the tool axis from the plane normal to the axis [deg]
+// (90: a straight plunge); 0 when the move does not descend.
+double descent_deg(const geom::Pose& from, const geom::Pose& to) {
+  const geom::Vec3 d = to.tip - from.tip;
+  const double along = geom::dot(d, from.axis);
+  if (!(-along > 1e-9)) return 0.0;
+  const double across = geom::norm(d - along * from.axis);
+  return std::atan2(-along, across) * 180.0 / std::numbers::pi;
 }
 
 }  // namespace
@@ -51,25 +63,48 @@ CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::Tool
     p.has_shank = tool.length_mm - p.shank_from_mm > 0.0;
     if (p.has_shank) p.shank = cylinder(shank_d, tool.length_mm - p.shank_from_mm, tools.chord_tol_mm());
     p.holder = cylinder(tool.holder_diameter_mm, tool.holder_length_mm, tools.chord_tol_mm());
+    p.centre_cutting = tool.centre_cutting;
+    if (!p.centre_cutting)
+      p.core = cylinder(kNonCuttingCoreFraction * tool.diameter_mm, tool.flute_length_mm, tools.chord_tol_mm());
     parts_.emplace(number, std::move(p));
   }
 }
 
-int CollisionChecker::findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, int rapid,
-                                  Finding (&out)[3]) {
-  int n = 0;
+int CollisionChecker::findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, int rapid, Findings& out) {
   if (m.ref.shape == nullptr) return 0;  // turning inserts and tool 0: not checked
-  if (rapid < 0) {
-    const nc::Segment* seg = index_.find(m.ref.id, nullptr);
-    rapid = seg != nullptr && seg->kind == nc::SegmentKind::Rapid ? 1 : 0;
-  }
-  if (rapid > 0) {
-    const Intrusion in = probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm);
-    if (in.deep_mm3 > 0.0) out[n++] = {EventKind::RapidIntoMaterial, in};
-  }
   const auto parts = parts_.find(m.tool);
-  if (parts == parts_.end()) return n;
-  const Parts& p = parts->second;
+  const Parts* p = parts == parts_.end() ? nullptr : &parts->second;
+  const int n = segment_findings(solid, m, index_.find(m.ref.id, nullptr), rapid, out, 0);
+  return p != nullptr ? part_findings(solid, m, *p, out, n) : n;
+}
+
+int CollisionChecker::segment_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const nc::Segment* seg,
+                                       int rapid_flag, Findings& out, int n) {
+  const bool rapid = rapid_flag >= 0 ? rapid_flag > 0 : seg != nullptr && seg->kind == nc::SegmentKind::Rapid;
+  const bool spindle_off = seg != nullptr && !seg->spindle_turning();
+  const double feed_limit = config_.max_cutting_feed_mm_per_min;
+  const bool too_fast =
+      seg != nullptr && seg->kind == nc::SegmentKind::Feed && feed_limit > 0.0 && seg->feed_mm_per_min > feed_limit;
+  if (rapid || spindle_off || too_fast) {
+    const Intrusion in = probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm);
+    if (in.deep_mm3 > 0.0) {
+      if (rapid) out[n++] = {EventKind::RapidIntoMaterial, in};
+      if (spindle_off) out[n++] = {EventKind::SpindleOff, in, seg->spindle_s};
+      if (too_fast) out[n++] = {EventKind::FeedLimit, in, seg->feed_mm_per_min};
+    }
+  }
+  return n;
+}
+
+int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const Parts& p,
+                                    Findings& out, int n) {
+  if (!p.centre_cutting) {
+    const double angle = descent_deg(m.ref.from, m.ref.to);
+    if (angle > config_.max_ramp_angle_deg) {
+      const Intrusion in = probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to), config_.tolerance_mm);
+      if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
+    }
+  }
   if (p.has_shank) {
     const Intrusion in =
         probe_.measure(solid, geom::Sweep(p.shank, raised(m.ref.from, p.shank_from_mm), raised(m.ref.to, p.shank_from_mm)),
@@ -99,6 +134,7 @@ Event CollisionChecker::event_of(const motion::TimedSweep& m, const Finding& f) 
   e.volume_mm3 = f.what.volume_mm3;
   e.depth_mm = f.what.depth_mm;
   e.region = f.what.region;
+  e.value = f.value;
   return e;
 }
 
@@ -111,13 +147,37 @@ std::size_t CollisionChecker::check(const geom::LbrSolid& solid, std::span<const
                                     std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to,
                                     std::vector<Event>& events) {
   if (!config_.enabled) return to;
-  Finding found[3];
+  Findings found;
   for (std::size_t i = from; i < to; ++i) {
     const int n = findings_of(solid, moves[i], rapid.empty() ? -1 : (rapid[i] != 0 ? 1 : 0), found);
     if (n > 0 && i > from) return i;
     for (int k = 0; k < n; ++k) add_event(events, event_of(moves[i], found[k]));
   }
   return to;
+}
+
+void check_travel(const nc::Toolpath& path, const nc::AxisVector& min, const nc::AxisVector& max, int channel,
+                  geom::MoveId base, std::vector<Event>& events) {
+  for (std::size_t i = 0; i < path.segments.size(); ++i) {
+    const nc::Segment& s = path.segments[i];
+    if (s.kind != nc::SegmentKind::Rapid && s.kind != nc::SegmentKind::Feed) continue;
+    const nc::AxisVector q = nc::machine_axes(path, s.end, s.tool);
+    for (int a = 0; a < nc::kAxes; ++a) {
+      const double beyond = std::max(min[a] - q[a], q[a] - max[a]);
+      if (!(beyond > 0.0)) continue;
+      Event e;
+      e.kind = EventKind::OverTravel;
+      e.source = path.source;
+      e.line = s.line;
+      e.move = static_cast<geom::MoveId>(base + i + 1);
+      e.tool = s.tool;
+      e.channel = channel;
+      e.position = {s.end[nc::X], s.end[nc::Y], s.end[nc::Z]};
+      e.axis = a;
+      e.value = beyond;
+      add_event(events, e);
+    }
+  }
 }
 
 }  // namespace lbr::verify

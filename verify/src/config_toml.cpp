@@ -5,6 +5,9 @@ namespace lbr::verify {
 void read_checks(cfg::Table& checks, CheckConfig& out) {
   out.enabled = checks.boolean("enabled", out.enabled);
   out.tolerance_mm = checks.number("tolerance_mm", out.tolerance_mm, 0.0, 10.0, "mm");
+  out.max_cutting_feed_mm_per_min =
+      checks.number("max_cutting_feed_mm_per_min", out.max_cutting_feed_mm_per_min, 0.0, 1e6, "mm/min");
+  out.max_ramp_angle_deg = checks.number("max_ramp_angle_deg", out.max_ramp_angle_deg, 0.0, 90.0, "deg");
 }
 
 }  // namespace lbr::verify

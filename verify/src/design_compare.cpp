@@ -248,6 +248,9 @@ void attribute_gouge(DesignReport& report, const geom::LbrSolid& solid, std::spa
                                     [&](const geom::Path& s) { return ClipperLib::PointInPolygon(p, s) != 0; });
     if (!inside) continue;
     report.gouge_move = m.ref.id;
+    report.gouge_tool = m.tool;
+    report.gouge_channel = m.channel;
+    report.gouge_t_s = m.t_s;
     const std::string* source = nullptr;
     if (const nc::Segment* seg = index.find(m.ref.id, &source); seg != nullptr) {
       report.gouge_line = seg->line;
@@ -309,6 +312,22 @@ void vertex_deviation(const std::vector<geom::Paths>& design, const geom::LbrSol
       if (const double d = depth_mm(inside); d >= half) out[v] = static_cast<float>(std::min(d, 1e6) + half);
     }
   }
+}
+
+std::optional<Event> gouge_event(const DesignReport& report, double tolerance_mm) {
+  if (!(report.max_gouge_mm > tolerance_mm)) return std::nullopt;
+  Event e;
+  e.kind = EventKind::DesignGouge;
+  e.t_s = report.gouge_t_s;
+  e.source = report.gouge_source;
+  e.line = e.last_line = report.gouge_line;
+  e.move = e.last_move = report.gouge_move;
+  e.tool = report.gouge_tool;
+  e.channel = report.gouge_channel;
+  e.position = report.max_gouge_at;
+  e.volume_mm3 = report.gouge_mm3;
+  e.depth_mm = report.max_gouge_mm;
+  return e;
 }
 
 std::string deviation_csv(const DesignReport& report) {

@@ -34,6 +34,7 @@ struct Tool {
   double shank_diameter_mm = 0.0; // 0 = same as diameter
   double holder_diameter_mm = 40.0;
   double holder_length_mm = 40.0;
+  bool centre_cutting = true;     // false: the end face does not cut at the centre (no plunging; process checks)
 
   // Empty string when the tool is valid, otherwise what is wrong (e.g.
   // "corner_radius_mm must be in (0, diameter/2]").

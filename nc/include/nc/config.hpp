@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@ namespace lbr::nc {
 
 // [machine]: rates, limits, sample period, G54 origin, diameter programming.
 struct MachineConfig {
+  static constexpr double kNoLimit = std::numeric_limits<double>::infinity();
   double rapid_mm_per_min = 15000.0;
   double tool_change_s = 0.0;
   std::array<double, 3> max_velocity_mm_per_min{0, 0, 0};  // per axis X Y Z; 0: the rapid rate
@@ -22,6 +24,10 @@ struct MachineConfig {
   double sample_period_ms = 4.0;      // emulator sample period
   std::array<double, 3> g54_origin_mm{0, 0, 0};  // machine coordinates of the G54 origin
   bool diameter_programming = true;   // lathe kinds: X words are diameters (G7) at program start
+  // Axis travel (soft limits) in machine coordinates of the spindle gauge line, X Y Z [mm] and
+  // A B C [deg] (nc::machine_axes); unlimited by default. The over-travel check uses them.
+  AxisVector travel_min{-kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit, -kNoLimit};
+  AxisVector travel_max{kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit, kNoLimit};
 };
 
 // [nc]: the G-code front ends (docs/nc-frontend.md). A new [nc] key is a field here, read in

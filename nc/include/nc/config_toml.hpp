@@ -11,7 +11,8 @@
 namespace lbr::nc {
 
 // [machine]: rapid_mm_per_min, tool_change_s, max_velocity_mm_per_min, max_accel_mm_per_s2,
-// g54_origin_mm, max_feed_mm_per_min, sample_period_ms, and diameter_programming (lathe kinds).
+// g54_origin_mm, max_feed_mm_per_min, sample_period_ms, travel_min_mm / travel_max_mm /
+// travel_min_deg / travel_max_deg, and diameter_programming (lathe kinds).
 void read_machine(cfg::Table& machine, MachineKind kind, MachineConfig& m);
 
 // [nc]: start_tool, subroutine_path (folders relative to the profile's folder, `file`'s parent).

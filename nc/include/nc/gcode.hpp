@@ -68,6 +68,11 @@ struct GcodeOptions {
 // Reads and interprets a file. Throws ParseError (line 0 when the file cannot be read).
 [[nodiscard]] Toolpath load_gcode(const std::string& path, const GcodeOptions& options);
 
+// Records the machine frame of `options` (work_offsets[0], tool_lengths) in `path`
+// (Toolpath::machine_origin, tool_lengths_mm): what both G-code front ends do, and what a
+// move list, whose tips are in the same frame, gets from its caller.
+void set_machine_frame(Toolpath& path, const GcodeOptions& options);
+
 // Reads a whole file into a string. Throws ParseError(path, 0, "cannot open file").
 [[nodiscard]] std::string read_text_file(const std::string& path);
 

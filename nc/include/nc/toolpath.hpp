@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,6 +35,11 @@ enum class PathControl : unsigned char {
   Blend,      // G64 [P] [Q]: blend corners within blend_tol_mm, keep speed through tangent runs
 };
 
+// Spindle state in effect for a segment (docs/nc-frontend.md#spindle): M3 (Cw), M4 (Ccw), M5
+// (Off; also at program start, as LinuxCNC powers up). Unknown: the front end has no spindle
+// words (move lists), so the process checks cannot judge it.
+enum class Spindle : unsigned char { Unknown, Off, Cw, Ccw };
+
 struct Segment {
   SegmentKind kind = SegmentKind::Feed;
   AxisVector end{};                       // axis positions at the end of the segment
@@ -46,6 +52,12 @@ struct Segment {
   PathControl path_control = PathControl::ExactStop;
   double blend_tol_mm = 0.0;              // G64 P: corner deviation bound [mm]; 0: none
   double naive_tol_mm = 0.0;              // G64 Q: collinear feeds within this merge [mm]; 0: off
+  Spindle spindle = Spindle::Unknown;     // spindle during the segment
+  double spindle_s = 0.0;                 // S word in effect: rpm (G97) or surface speed (G96); 0: not turning
+  // True when the spindle turns: M3 or M4 with S > 0 (Unknown counts as turning: not judged).
+  [[nodiscard]] bool spindle_turning() const noexcept {
+    return spindle == Spindle::Unknown || ((spindle == Spindle::Cw || spindle == Spindle::Ccw) && spindle_s > 0.0);
+  }
 };
 
 struct Toolpath {
@@ -54,7 +66,16 @@ struct Toolpath {
   std::array<double, 3> start_axis{0, 0, 1};
   int start_tool = 0;
   std::vector<Segment> segments;
+  // The machine frame (docs/nc-frontend.md#frames): machine coordinates of this frame's origin
+  // (the G54 origin at program start) and the gauge length the front end took off each
+  // tool's tip along Z (missing: 0). machine_axes() adds them back.
+  AxisVector machine_origin{};
+  std::map<int, double> tool_lengths_mm;
 };
+
+// Machine axis positions (the spindle gauge line in machine coordinates, rotary axes as
+// programmed) of the tool-tip position `tip` of `path` with `tool` in the spindle.
+[[nodiscard]] AxisVector machine_axes(const Toolpath& path, const AxisVector& tip, int tool) noexcept;
 
 // Parse errors in any front end: what() is "FILE:LINE: message".
 class ParseError : public std::runtime_error {

@@ -4,7 +4,11 @@
 // Checks: a rapid sweep that removes material (rapid-into-material); the non-cutting parts
 // of a milling tool, the shank (between the flutes' end and the gauge length, at the shank
 // diameter) and the holder (from the gauge length up, at the holder diameter), meeting
-// material (shank-in-material, holder-in-material). Turning inserts are not checked.
+// material (shank-in-material, holder-in-material); a cutting sweep that removes material
+// while the segment's spindle is off (spindle-off) or faster than the feed limit
+// (feed-limit); the centre core of a non-centre-cutting tool meeting material on a descent
+// steeper than the ramp limit (plunge-non-centre-cutting). Turning inserts are not checked.
+// check_travel() checks a tool path's axis positions against the machine's travel.
 //
 // The batch runner asks `check()` before subtracting a batch of moves. The stock before the
 // batch holds at least the material present at any move of it (cutting only removes), so a
@@ -37,7 +41,16 @@ struct CheckConfig {
   // Material closer than this to a sweep's boundary is not a finding: a rapid or a holder
   // may graze a wall by less (chord tolerance of two polygonised circles, cusps) [mm].
   double tolerance_mm = 0.01;
+  // feed-limit: feed moves faster than this that remove material [mm/min]; 0: not checked.
+  double max_cutting_feed_mm_per_min = 0.0;
+  // plunge-non-centre-cutting: a descent along the tool axis steeper than this (from the
+  // plane normal to the axis) is a plunge [deg].
+  double max_ramp_angle_deg = 3.0;
 };
+
+// The centre core of a non-centre-cutting tool (the part of the end face that does not cut)
+// is taken as this fraction of its cutting diameter (docs/verification.md).
+inline constexpr double kNonCuttingCoreFraction = 0.25;
 
 // Which program segment made a move: move ids → (source, segment), for the ids the batch
 // runner gives (docs/formats.md#move-ids): a path's segments get ids base + index + 1.
@@ -77,18 +90,29 @@ class CollisionChecker {
 
  private:
   struct Parts {
-    geom::CutterShape shank, holder;
+    geom::CutterShape shank, holder, core;
     double shank_from_mm = 0.0;   // shank bottom above the tip [mm]
     double holder_from_mm = 0.0;  // holder face above the tip [mm]
     bool has_shank = false;
+    bool centre_cutting = true;   // false: `core` is the end face's non-cutting centre
   };
   struct Finding {
     EventKind kind;
     Intrusion what;
+    double value = 0.0;  // Event::value
   };
-  // The findings of one move against `solid`; returns how many (0..3) were written.
-  // `rapid`: 1 / 0 the move is / is not a rapid, -1 the move index tells.
-  int findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, int rapid, Finding (&out)[3]);
+  static constexpr int kMaxFindings = 6;
+  using Findings = Finding[kMaxFindings];
+  // The findings of one move against `solid`; returns how many were written. `rapid`: 1 / 0
+  // the move is / is not a rapid, -1 the move's program segment tells.
+  int findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, int rapid, Findings& out);
+  // Rapid, spindle-off and feed-limit (the cutting sweep; spindle and feed need the move's
+  // program segment `seg`, which live streams lack: null), written from out[n]; returns the
+  // new count.
+  int segment_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const nc::Segment* seg, int rapid,
+                       Findings& out, int n);
+  // Plunge (the non-cutting core), shank and holder, written from out[n]; returns the new count.
+  int part_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const Parts& p, Findings& out, int n);
   [[nodiscard]] Event event_of(const motion::TimedSweep& m, const Finding& f) const;
 
   CheckConfig config_;
@@ -97,5 +121,12 @@ class CollisionChecker {
   std::map<int, Parts> parts_;
   IntrusionProbe probe_;
 };
+
+// over-travel: appends an event for every run of motion segments of `path` (channel
+// `channel`, move ids base + index + 1) whose end lies outside [min, max] on an axis, in
+// machine coordinates (nc::machine_axes): the axis, the distance beyond the limit (the
+// run's largest) and the tool tip. The tool path alone decides, so it runs before the cut.
+void check_travel(const nc::Toolpath& path, const nc::AxisVector& min, const nc::AxisVector& max, int channel,
+                  geom::MoveId base, std::vector<Event>& events);
 
 }  // namespace lbr::verify

@@ -7,7 +7,7 @@
 
 namespace lbr::verify {
 
-// Reads [checks]: enabled (bool), tolerance_mm. The caller rejects unknown keys afterwards.
+// Reads [checks]: enabled (bool), tolerance_mm, max_cutting_feed_mm_per_min, max_ramp_angle_deg. The caller rejects unknown keys afterwards.
 void read_checks(cfg::Table& checks, CheckConfig& out);
 
 }  // namespace lbr::verify

@@ -10,6 +10,7 @@
 // Setup-time code: allocates; errors throw DesignError("NAME: what was expected").
 #pragma once
 
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -58,6 +59,8 @@ struct DesignReport {
   geom::MoveId gouge_move = 0;     // earliest move whose section contains it (0: none found)
   std::string gouge_source;        // that move's program and line (empty / 0: unknown)
   int gouge_line = 0;
+  int gouge_tool = 0, gouge_channel = 0;  // that move's tool and channel
+  double gouge_t_s = 0.0;                 // that move's end time [s] (0: not timed)
   std::vector<DesignLevel> levels; // the levels with a gouge or an excess, bottom up
 };
 
@@ -80,6 +83,10 @@ void attribute_gouge(DesignReport& report, const geom::LbrSolid& solid, std::spa
 void vertex_deviation(const std::vector<geom::Paths>& design, const geom::LbrSolid& solid,
                       std::span<const float> positions, std::span<const float> normals, double tolerance_mm,
                       std::vector<float>& out);
+// A design-gouge event (docs/verification.md) when the deepest gouge is deeper than
+// `tolerance_mm`: at the deepest point, with the whole gouge volume and the attributed move.
+// The checks' counts and `--fail-on error` then cover it like any other error.
+[[nodiscard]] std::optional<Event> gouge_event(const DesignReport& report, double tolerance_mm);
 
 // The report's levels as CSV (columns in docs/formats.md#deviation-csv).
 [[nodiscard]] std::string deviation_csv(const DesignReport& report);

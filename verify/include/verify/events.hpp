@@ -21,6 +21,11 @@ enum class EventKind : unsigned char {
   RapidIntoMaterial,  // a rapid (G0) sweep removes material
   ShankInMaterial,    // the tool between the flutes' end and the holder face meets material
   HolderInMaterial,   // the tool holder meets material
+  SpindleOff,         // a move removes material while the spindle is off (M5) or S is 0
+  Plunge,             // a non-centre-cutting tool descends steeper than the ramp limit into material under its centre
+  FeedLimit,          // a feed move removes material faster than [checks] max_cutting_feed_mm_per_min
+  OverTravel,         // a move ends outside the machine's axis travel ([machine] travel_*)
+  DesignGouge,        // the final stock lacks design material deeper than the design tolerance
 };
 enum class Severity : unsigned char { Warning, Error };
 
@@ -43,8 +48,16 @@ struct Event {
   double volume_mm3 = 0.0;      // material met, summed over the run [mm3]
   double depth_mm = 0.0;        // largest Z extent of the material met by one move [mm]
   int region = -1;              // stock region where the first move met the most material
+  int axis = -1;                // over-travel: the axis (nc::Axis: 0..5 = X..C) that left its travel
+  // The kind's own figure, the largest of the run: spindle-off the S word in effect;
+  // plunge the descent angle from the plane normal to the tool axis [deg]; feed-limit the
+  // programmed feed [mm/min]; over-travel the distance beyond the limit [mm | deg].
+  double value = 0.0;
   [[nodiscard]] Severity severity() const noexcept { return severity_of(kind); }
 };
+
+// The letter of Event::axis ("X" .. "C"), or "" when it has none.
+[[nodiscard]] std::string axis_name(int axis);
 
 // Counts of a list of events by severity.
 struct EventCounts {
@@ -58,7 +71,7 @@ struct EventCounts {
 [[nodiscard]] std::string describe(const Event& e);
 
 // Appends `e` to `events`, or merges it into one of the last events (one move may raise
-// several kinds) when that one is the same kind, tool and channel and `e`'s move follows
+// several kinds) when that one is the same kind, tool, channel and axis and `e`'s move follows
 // its last move directly (same id: another sub-step
 // of a rotary move; id + 1: the next segment or sample).
 void add_event(std::vector<Event>& events, const Event& e);
