@@ -99,6 +99,9 @@ struct LiveResult {
   // and the source position it skipped to (0: not resumed).
   std::uint64_t snapshots_written = 0, snapshots_failed = 0, resumed_generation = 0, resumed_position = 0;
   double snapshot_copy_max_ms = 0;  // longest copy of the solid into the writer's slot (geometry thread)
+  // Power-loss catch-up (docs/snapshot.md): samples applied at start from the --record file
+  // after the snapshot's position, and recorded ones skipped there because the solid held them.
+  std::uint64_t samples_caught_up = 0, catch_up_skipped = 0;
 };
 
 using StatusFn = std::function<void(const std::string& line)>;

@@ -38,7 +38,7 @@ std::unique_ptr<hal::Source> make_emulator_source(const Profile& profile, const 
       throw std::runtime_error(path.source + ":" + std::to_string(sg.line) + ": tool " + std::to_string(sg.tool) +
                                " is not in the tool table of " + profile.source);
   return hal::make_generator_source(std::make_unique<EmulatorGenerator>(path, live_emulator_limits(profile), skip), arg,
-                                    profile.live, speed);
+                                    profile.live, speed, skip + 1);
 }
 
 }  // namespace
