@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fuzz campaign: runs every libFuzzer target in turn (nice'd, one at a time) for RUNS
+# Fuzz campaign: runs every libFuzzer target in turn (nice 19: idle CPU only; slowest first) for RUNS
 # executions or SECONDS, whichever comes first, from its committed seed corpus; prints one
 # line per target (executions, execs/s, coverage, features, corpus size, crashes) and keeps
 # new corpus entries and crash inputs in OUT/NAME/. Figures: docs/reliability.md.
@@ -15,8 +15,8 @@ RUNS="${3:-10000000}"
 SECONDS_MAX="${4:-600}"
 shift $(( $# < 4 ? $# : 4 ))
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(serial candump canopen movelist gcode rs274_canon profile lbrs)
-declare -A MAXLEN=([serial]=512 [candump]=128 [canopen]=1024 [gcode]=512 [rs274_canon]=512 [movelist]=512 [profile]=2048 [lbrs]=8192)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(gcode profile lbrs rs274_canon movelist stl canopen serial candump)
+declare -A MAXLEN=([serial]=512 [candump]=128 [canopen]=1024 [gcode]=512 [rs274_canon]=512 [movelist]=512 [profile]=2048 [lbrs]=8192 [stl]=1024)
 mkdir -p "$OUT"
 printf "%-12s %12s %9s %7s %8s %7s %7s %s\n" target execs execs/s cov ft corpus crashes seconds
 for t in "${TARGETS[@]}"; do
@@ -24,7 +24,7 @@ for t in "${TARGETS[@]}"; do
   mkdir -p "$d/corpus" "$d/artifacts"
   t0=$(date +%s)
   rc=0
-  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 nice -n 10 "$BUILD/fuzz/fuzz_$t" -runs="$RUNS" \
+  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 nice -n 19 "$BUILD/fuzz/fuzz_$t" -runs="$RUNS" \
     -max_total_time="$SECONDS_MAX" -max_len="${MAXLEN[$t]}" -rss_limit_mb=2048 -print_final_stats=1 \
     -artifact_prefix="$d/artifacts/" "$d/corpus" "$SRC/corpus/$t" > "$d/log.txt" 2>&1 || rc=$?
   secs=$(( $(date +%s) - t0 ))

@@ -38,6 +38,8 @@ app::SnapshotState cut_state(std::uint64_t generation, double depth_mm) {
   s.source = "emulator:demo";
   s.have[0] = true;
   s.last[0].seq = s.source_position;
+  s.last[0].t_src_ns = 1'700'000'000'123'456'000;
+  s.record_file = "/var/lib/lbrsim/mill/in.log";
   s.last[0].tool = 1;
   s.last[0].mask = 0b111;
   s.last[0].q = {50, 30, -depth_mm, 0, 0, 0};
@@ -79,10 +81,35 @@ TEST(Snapshot, RoundTripKeepsLevelsAndPositions) {
   EXPECT_TRUE(d.have[0]);
   EXPECT_FALSE(d.have[1]);
   EXPECT_EQ(d.last[0].seq, 1007u);
+  EXPECT_EQ(d.last[0].t_src_ns, 1'700'000'000'123'456'000);
+  EXPECT_EQ(d.record_file, "/var/lib/lbrsim/mill/in.log");
   EXPECT_DOUBLE_EQ(d.last[0].q[2], -2.0);
   EXPECT_LT(s.solid.volume_mm3(), s.solid.initial_volume_mm3() - 100.0);  // the cut is there
   EXPECT_DOUBLE_EQ(d.solid.volume_mm3(), s.solid.volume_mm3());
   EXPECT_EQ(d.solid.levels(), s.solid.levels());
+}
+
+// Format version 1 (before the catch-up: no record file, no sender times) is still read.
+TEST(Snapshot, VersionOneIsStillRead) {
+  app::SnapshotState s = cut_state(3, 1.0);
+  s.record_file.clear();
+  std::vector<std::uint8_t> b = app::encode_snapshot(s);
+  const std::size_t source_end = 56 + s.source.size();  // docs/snapshot.md: the source spec ends here
+  b.erase(b.begin() + static_cast<std::ptrdiff_t>(source_end), b.begin() + static_cast<std::ptrdiff_t>(source_end + 4));
+  for (int c = 0; c < hal::kMaxChannels; ++c) {  // per channel: drop the i64 sender time after the u64 sequence
+    const std::size_t at = source_end + 4 + static_cast<std::size_t>(c) * 61 + 1 + 8;
+    b.erase(b.begin() + static_cast<std::ptrdiff_t>(at), b.begin() + static_cast<std::ptrdiff_t>(at + 8));
+  }
+  b[8] = 1;  // format version
+  b.resize(b.size() - 4);
+  const std::uint32_t crc = app::crc32(b.data(), b.size());
+  for (int k = 0; k < 4; ++k) b.push_back(static_cast<std::uint8_t>(crc >> (8 * k)));
+  const app::SnapshotState d = app::decode_snapshot(b, "v1");
+  EXPECT_EQ(d.generation, 3u);
+  EXPECT_EQ(d.last[0].seq, 1003u);
+  EXPECT_EQ(d.last[0].t_src_ns, 0);
+  EXPECT_TRUE(d.record_file.empty());
+  EXPECT_DOUBLE_EQ(d.solid.volume_mm3(), s.solid.volume_mm3());
 }
 
 TEST(Snapshot, CorruptAndTruncatedFilesAreRejectedWithTheirOffset) {

@@ -1,6 +1,7 @@
 // Invariants of subtraction: grid independence, translation, idempotence, splitting moves,
 // monotonicity and the representation invariants, on fixed and seeded random programs.
 #include <cstdlib>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -275,5 +276,57 @@ TEST(Invariants, VerticalCoherenceChangesNothing) {
         for (std::size_t p = 0; p < on.cell(r, l).polys.size(); ++p)
           ASSERT_EQ(on.cell(r, l).polys[p].outer.cut_by, off.cell(r, l).polys[p].outer.cut_by);
       }
+  }
+}
+
+// Regression (fuzz_lbrs): a cylinder of diameter 5e-324 mm passed the header checks and its
+// polygonised circle had NaN vertices (UB converting them to kernel units). Diameters below
+// 0.001 mm are refused, by the reader and by the solid itself.
+TEST(Invariants, RegressionDegenerateCylinderIsRefused) {
+  geom::SolidSpec sp = test::box_spec({0, 0, 0}, {1, 1, 2}, 1.0, 1, 1);
+  sp.shape = geom::SolidSpec::Shape::Cylinder;
+  sp.cylinder = {0.0, 0.0, 5e-324, 0.0, 2.0};
+  EXPECT_THROW((void)geom::LbrSolid(sp), std::invalid_argument);
+  sp.cylinder.diameter_mm = 10.0;
+  std::vector<std::uint8_t> bytes = geom::to_bytes(geom::LbrSolid(sp));
+  const double tiny = 5e-324;
+  std::memcpy(bytes.data() + 56 + 16, &tiny, 8);  // the diameter (docs/formats.md#levels-file)
+  try {
+    (void)geom::from_bytes(bytes);
+    FAIL() << "a degenerate cylinder was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("LBRS: at byte 104: bad header: cylinder stock needs a diameter >= 0.001 mm"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// The reader leaves the stock's cells unbuilt (it sets every cell) and refuses a level count
+// that disagrees with the stock before allocating the grid; the initial volume is the
+// filled solid's to the bit.
+TEST(Invariants, ReaderBuildsNoStockCellsAndChecksTheLevelCountFirst) {
+  geom::SolidSpec sp = test::box_spec({0, 0, 0}, {10, 10, 4}, 1.0, 2, 2);
+  sp.shape = geom::SolidSpec::Shape::Cylinder;
+  sp.cylinder = {5.0, 5.0, 9.0, 0.0, 4.0};
+  const geom::LbrSolid full(sp);
+  const geom::LbrSolid later(sp, geom::LbrSolid::CellsSetLater{});
+  EXPECT_EQ(later.initial_volume_mm3(), full.initial_volume_mm3());
+  EXPECT_EQ(later.volume_mm3(), 0.0);
+  EXPECT_EQ(geom::LbrSolid::level_count(sp), 4.0);
+  const geom::LbrSolid back = geom::from_bytes(geom::to_bytes(full));
+  EXPECT_EQ(back.initial_volume_mm3(), full.initial_volume_mm3());
+  EXPECT_EQ(back.volume_mm3(), full.volume_mm3());
+
+  // A 0.001 mm level spacing on a 10 m tall stock: 10 million levels, in a file of 120 bytes.
+  std::vector<std::uint8_t> bytes = geom::to_bytes(full);
+  const double spacing = 0.001, z_max = 10000.0;
+  std::memcpy(bytes.data() + 40, &spacing, 8);
+  std::memcpy(bytes.data() + 56 + 32, &z_max, 8);
+  try {
+    (void)geom::from_bytes(bytes);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("level count 4 does not match stock and spacing (10000000)"), std::string::npos)
+        << e.what();
   }
 }

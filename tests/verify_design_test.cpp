@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "app/batch.hpp"
 #include "app/outputs.hpp"
@@ -160,4 +161,36 @@ TEST(DesignCompare, AnOverCutPassIsMeasuredAndLocated) {
   for (const char* key : {"\"design_gouge_mm3\": 150.", "\"design_excess_mm3\"", "\"max_gouge_mm\": 0.30",
                           "\"max_gouge_line\": 20", "\"max_gouge_at_mm\""})
     EXPECT_NE(json.find(key), std::string::npos) << key;
+}
+
+// Regression (fuzz_stl): NaN, infinite and huge coordinates were accepted and reached the
+// slicer; they are refused with the place named (ASCII: the line; binary: byte, triangle, vertex).
+TEST(StlReader, RegressionNonFiniteOrHugeVerticesAreRefused) {
+  const std::string tri = "solid t\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex X 1 0\n"
+                          " endloop\n endfacet\nendsolid t\n";
+  for (const char* bad : {"nan", "inf", "-1e300", "200000"}) {
+    std::string text = tri;
+    text.replace(text.find('X'), 1, bad);
+    try {
+      (void)verify::parse_stl(text, "bad.stl");
+      FAIL() << bad << " was accepted";
+    } catch (const verify::StlError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.stl:6: expected a finite coordinate within"), std::string::npos) << e.what();
+    }
+  }
+  std::string ok = tri;
+  ok.replace(ok.find('X'), 1, "107000");  // inside the kernel's ±107374 mm
+  EXPECT_EQ(verify::parse_stl(ok, "ok.stl").triangles.size(), 1u);
+
+  verify::StlMesh m = test::box_mesh({0, 0, 0}, {1, 1, 1});
+  m.triangles[3].v[2].y = std::numeric_limits<double>::infinity();  // written as float inf
+  try {
+    (void)verify::parse_stl(verify::stl_binary(m), "bad-binary.stl");
+    FAIL() << "an infinite binary vertex was accepted";
+  } catch (const verify::StlError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad-binary.stl: at byte " + std::to_string(84 + 3 * 50 + 12 + 24) +
+                                         ": triangle 4, vertex 3: expected a finite coordinate"),
+              std::string::npos)
+        << e.what();
+  }
 }

@@ -45,7 +45,7 @@ if [ "${LBR_SKIP_SANITIZERS:-0}" != "1" ]; then
     # fuzz_profile links the whole application (every module's profile reader): it runs in the
     # campaigns (docs/reliability.md), not here, so this stage builds only the decoder libraries.
     cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_serial fuzz_candump fuzz_canopen fuzz_gcode \
-          fuzz_rs274_canon fuzz_movelist fuzz_lbrs
+          fuzz_rs274_canon fuzz_movelist fuzz_lbrs fuzz_stl
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
       ctest --test-dir build-fuzz --output-on-failure --parallel "$(nproc)" -L fuzz -R '^fuzz_' -E '^fuzz_profile$'
   fi

@@ -96,6 +96,8 @@ std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   j["snapshot_copy_max_ms"] = r.snapshot_copy_max_ms;
   j["resumed_generation"] = r.resumed_generation;
   j["resumed_position"] = r.resumed_position;
+  j["samples_caught_up"] = r.samples_caught_up;
+  j["catch_up_skipped"] = r.catch_up_skipped;
   j["peak_rss_mb"] = peak_rss_mb();
   put_events_json(r.events, r.checks, j);
   j["events_dropped"] = r.events_dropped;

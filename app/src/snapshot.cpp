@@ -23,7 +23,7 @@ static_assert(std::endian::native == std::endian::little, "the snapshot writer a
 namespace {
 
 constexpr char kMagic[8] = {'L', 'B', 'R', 'S', 'N', 'A', 'P', '1'};
-constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kFormatVersion = 2;  // 1 is still read (no sender times, no record file)
 const char* const kFiles[2] = {"snapshot-a.lbrsnap", "snapshot-b.lbrsnap"};
 
 class Writer {
@@ -72,15 +72,17 @@ class Reader {
 void put_sample(Writer& w, bool have, const hal::AxisSample& s) {
   w.put<std::uint8_t>(have ? 1 : 0);
   w.put<std::uint64_t>(s.seq);
+  w.put<std::int64_t>(s.t_src_ns);
   w.put<std::uint8_t>(s.channel);
   w.put<std::uint8_t>(s.mask);
   w.put<std::int16_t>(s.tool);
   for (double q : s.q) w.put<double>(q);
 }
 
-void get_sample(Reader& r, bool& have, hal::AxisSample& s) {
+void get_sample(Reader& r, std::uint32_t version, bool& have, hal::AxisSample& s) {
   have = r.get<std::uint8_t>("channel flag") != 0;
   s.seq = r.get<std::uint64_t>("sample sequence");
+  if (version >= 2) s.t_src_ns = r.get<std::int64_t>("sample sender time");
   s.channel = r.get<std::uint8_t>("sample channel");
   s.mask = r.get<std::uint8_t>("sample mask");
   s.tool = r.get<std::int16_t>("sample tool");
@@ -126,6 +128,8 @@ std::vector<std::uint8_t> encode_snapshot(const SnapshotState& s) {
   w.put<double>(s.wall_time_s);
   w.put<std::uint32_t>(static_cast<std::uint32_t>(s.source.size()));
   w.bytes(reinterpret_cast<const std::uint8_t*>(s.source.data()), s.source.size());
+  w.put<std::uint32_t>(static_cast<std::uint32_t>(s.record_file.size()));
+  w.bytes(reinterpret_cast<const std::uint8_t*>(s.record_file.data()), s.record_file.size());
   w.put<std::uint32_t>(hal::kMaxChannels);
   for (int c = 0; c < hal::kMaxChannels; ++c) put_sample(w, s.have[c], s.last[c]);
   const std::vector<std::uint8_t> levels = geom::to_bytes(s.solid);
@@ -147,8 +151,9 @@ SnapshotState decode_snapshot(const std::vector<std::uint8_t>& bytes, const std:
   if (crc32(bytes.data(), bytes.size() - 4) != stored)
     throw std::runtime_error(name + ": at byte " + std::to_string(bytes.size() - 4) +
                              ": CRC-32 mismatch (truncated or corrupt snapshot)");
-  if (const auto v = r.get<std::uint32_t>("format version"); v != kFormatVersion)
-    r.fail("format version " + std::to_string(kFormatVersion) + " expected, got " + std::to_string(v));
+  const auto version = r.get<std::uint32_t>("format version");
+  if (version != 1 && version != kFormatVersion)
+    r.fail("format version 1 or " + std::to_string(kFormatVersion) + " expected, got " + std::to_string(version));
   SnapshotState s;
   s.generation = r.get<std::uint64_t>("generation");
   s.source_position = r.get<std::uint64_t>("source position");
@@ -157,9 +162,13 @@ SnapshotState decode_snapshot(const std::vector<std::uint8_t>& bytes, const std:
   s.wall_time_s = r.get<double>("wall time");
   const std::vector<std::uint8_t> src = r.take(r.get<std::uint32_t>("source length"), "source spec");
   s.source.assign(src.begin(), src.end());
+  if (version >= 2) {
+    const std::vector<std::uint8_t> rec = r.take(r.get<std::uint32_t>("record file length"), "record file");
+    s.record_file.assign(rec.begin(), rec.end());
+  }
   if (r.get<std::uint32_t>("channel count") != hal::kMaxChannels)
     r.fail("channel count " + std::to_string(hal::kMaxChannels) + " expected");
-  for (int c = 0; c < hal::kMaxChannels; ++c) get_sample(r, s.have[c], s.last[c]);
+  for (int c = 0; c < hal::kMaxChannels; ++c) get_sample(r, version, s.have[c], s.last[c]);
   const auto n = r.get<std::uint64_t>("level file length");
   if (n != bytes.size() - 4 - r.pos()) r.fail("level file length " + std::to_string(n) + " does not match the file size");
   try {

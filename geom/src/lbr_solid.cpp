@@ -19,6 +19,7 @@ namespace {
 constexpr int kMaxRegionsPerAxis = 256;
 constexpr long kMaxLevels = 200000;
 constexpr long kMaxCells = 8000000;
+constexpr double kMinCylinderDiameterMm = 0.001;
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
@@ -28,7 +29,11 @@ bool in_range(double mm) { return std::isfinite(mm) && std::abs(mm) <= kSafeRang
 
 }  // namespace
 
-LbrSolid::LbrSolid(const SolidSpec& spec) : spec_(spec), ws_(std::make_unique<detail::SubtractWorkspace>()) {
+LbrSolid::LbrSolid(const SolidSpec& spec) : LbrSolid(spec, true) {}
+
+LbrSolid::LbrSolid(const SolidSpec& spec, CellsSetLater) : LbrSolid(spec, false) {}
+
+LbrSolid::LbrSolid(const SolidSpec& spec, bool fill) : spec_(spec), ws_(std::make_unique<detail::SubtractWorkspace>()) {
   require(std::isfinite(spec.level_spacing_mm) && spec.level_spacing_mm >= 0.001 && spec.level_spacing_mm <= 1000.0,
           "level spacing must be in [0.001, 1000] mm");
   require(spec.regions_x >= 1 && spec.regions_x <= kMaxRegionsPerAxis && spec.regions_y >= 1 &&
@@ -46,7 +51,10 @@ LbrSolid::LbrSolid(const SolidSpec& spec) : spec_(spec), ws_(std::make_unique<de
     xy_ = Rect{to_units(b.min.x), to_units(b.min.y), to_units(b.max.x), to_units(b.max.y)};
   } else {
     const CylinderStock& c = spec.cylinder;
-    require(std::isfinite(c.diameter_mm) && c.diameter_mm > 0.0, "cylinder stock needs a diameter > 0");
+    // Below a micrometre the polygonised circle degenerates (radius 0 in kernel units: the
+    // vertex radius became NaN, found by fuzz_lbrs).
+    require(std::isfinite(c.diameter_mm) && c.diameter_mm >= kMinCylinderDiameterMm,
+            "cylinder stock needs a diameter >= 0.001 mm");
     for (double v : {c.center_x_mm - c.diameter_mm, c.center_x_mm + c.diameter_mm, c.center_y_mm - c.diameter_mm,
                      c.center_y_mm + c.diameter_mm, c.z_min_mm, c.z_max_mm})
       require(in_range(v), "cylinder stock must lie within ±" + std::to_string(kSafeRangeMm) + " mm");
@@ -57,14 +65,20 @@ LbrSolid::LbrSolid(const SolidSpec& spec) : spec_(spec), ws_(std::make_unique<de
     xy_ = Rect{to_units(c.center_x_mm - r), to_units(c.center_y_mm - r), to_units(c.center_x_mm + r),
                to_units(c.center_y_mm + r)};
   }
-  const double n = std::ceil((z1_ - z0_) / spec.level_spacing_mm - 1e-9);
+  const double n = level_count(spec);
   require(n >= 1 && n <= kMaxLevels, "stock height / level spacing gives " + std::to_string(static_cast<long>(n)) +
                                          " levels; at most " + std::to_string(kMaxLevels) + " are supported");
   levels_ = static_cast<int>(n);
   require(static_cast<long>(levels_) * regions() <= kMaxCells,
           "levels x regions = " + std::to_string(static_cast<long>(levels_) * regions()) + " cells; at most " +
               std::to_string(kMaxCells) + " are supported");
-  init_cells();
+  init_cells(fill);
+}
+
+double LbrSolid::level_count(const SolidSpec& spec) noexcept {
+  const bool box = spec.shape == SolidSpec::Shape::Box;
+  const double z0 = box ? spec.box.min.z : spec.cylinder.z_min_mm, z1 = box ? spec.box.max.z : spec.cylinder.z_max_mm;
+  return std::ceil((z1 - z0) / spec.level_spacing_mm - 1e-9);
 }
 
 LbrSolid::~LbrSolid() = default;
@@ -79,49 +93,64 @@ LbrSolid& LbrSolid::operator=(const LbrSolid& o) {
   return *this;
 }
 
-void LbrSolid::init_cells() {
+void LbrSolid::init_cells(bool fill) {
   const int nx = spec_.regions_x, ny = spec_.regions_y;
   xs_.resize(nx + 1);
   ys_.resize(ny + 1);
   for (int i = 0; i <= nx; ++i) xs_[i] = xy_.x0 + (xy_.x1 - xy_.x0) * i / nx;
   for (int j = 0; j <= ny; ++j) ys_[j] = xy_.y0 + (xy_.y1 - xy_.y0) * j / ny;
-
-  Path circle;
-  if (spec_.shape == SolidSpec::Shape::Cylinder) {
-    const CylinderStock& c = spec_.cylinder;
-    const double r = 0.5 * c.diameter_mm;
-    const int segs = Sweep::circle_segments(r, spec_.chord_tol_mm);
-    const double rho = r * 2.0 / (1.0 + std::cos(std::numbers::pi / segs));
-    for (int k = 0; k < segs; ++k) {
-      const double a = 2.0 * std::numbers::pi * k / segs;
-      circle.push_back({to_units(c.center_x_mm + rho * std::cos(a)), to_units(c.center_y_mm + rho * std::sin(a))});
-    }
-  }
   cells_.assign(static_cast<std::size_t>(regions()) * levels_, Cell{});
   dirty_flag_.assign(cells_.size(), 0);
+  std::vector<double> region_area(static_cast<std::size_t>(regions()));
+  const Path circle = stock_circle();
   for (int reg = 0; reg < regions(); ++reg) {
-    const Rect rr = region_rect(reg);
-    std::vector<Polygon> polys;
-    if (spec_.shape == SolidSpec::Shape::Box) {
-      Polygon p;
-      p.outer.pts = detail::rect_path(rr);
-      p.bbox = rr;
-      polys.push_back(std::move(p));
-    } else {
-      ClipperLib::Clipper c;
-      c.AddPath(circle, ClipperLib::ptSubject, true);
-      c.AddPath(detail::rect_path(rr), ClipperLib::ptClip, true);
-      ClipperLib::PolyTree tree;
-      c.Execute(ClipperLib::ctIntersection, tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-      detail::append_polygons(tree, polys);
-    }
-    for (int l = 0; l < levels_; ++l) {
-      Cell& cell = cells_[static_cast<std::size_t>(reg) * levels_ + l];
-      cell.polys = polys;
-      detail::refresh_cell(cell);
-    }
+    Cell stock;
+    stock.polys = stock_polygons(reg, circle);
+    detail::refresh_cell(stock);
+    region_area[static_cast<std::size_t>(reg)] = stock.area_units2;
+    for (int l = 0; fill && l < levels_; ++l) cells_[static_cast<std::size_t>(reg) * levels_ + l] = stock;
   }
-  initial_volume_mm3_ = volume_mm3();
+  // The stock's volume, summed as volume_mm3() sums the filled cells (the same value to the
+  // bit): per level the regions' areas in order, times the level's thickness.
+  initial_volume_mm3_ = 0.0;
+  for (int l = 0; l < levels_; ++l) {
+    double a = 0.0;
+    for (double r : region_area) a += r;
+    initial_volume_mm3_ += area_to_mm2(a) * level_thickness_mm(l);
+  }
+}
+
+Path LbrSolid::stock_circle() const {
+  Path circle;
+  if (spec_.shape != SolidSpec::Shape::Cylinder) return circle;
+  const CylinderStock& c = spec_.cylinder;
+  const double r = 0.5 * c.diameter_mm;
+  const int segs = Sweep::circle_segments(r, spec_.chord_tol_mm);
+  const double rho = r * 2.0 / (1.0 + std::cos(std::numbers::pi / segs));
+  for (int k = 0; k < segs; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / segs;
+    circle.push_back({to_units(c.center_x_mm + rho * std::cos(a)), to_units(c.center_y_mm + rho * std::sin(a))});
+  }
+  return circle;
+}
+
+std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle) const {
+  const Rect rr = region_rect(reg);
+  std::vector<Polygon> polys;
+  if (spec_.shape == SolidSpec::Shape::Box) {
+    Polygon p;
+    p.outer.pts = detail::rect_path(rr);
+    p.bbox = rr;
+    polys.push_back(std::move(p));
+  } else {
+    ClipperLib::Clipper c;
+    c.AddPath(circle, ClipperLib::ptSubject, true);
+    c.AddPath(detail::rect_path(rr), ClipperLib::ptClip, true);
+    ClipperLib::PolyTree tree;
+    c.Execute(ClipperLib::ctIntersection, tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+    detail::append_polygons(tree, polys);
+  }
+  return polys;
 }
 
 double LbrSolid::level_bottom_mm(int level) const noexcept { return z0_ + level * spec_.level_spacing_mm; }

@@ -2,6 +2,8 @@
 #include "geom/serialize.hpp"
 
 #include <bit>
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -136,9 +138,14 @@ LbrSolid from_bytes(const std::vector<std::uint8_t>& bytes) {
   if (static_cast<double>(levels) * sp.regions_x * sp.regions_y * 4.0 > static_cast<double>(r.left()))
     r.fail("grid of " + std::to_string(levels) + " levels x " + std::to_string(sp.regions_x) + "x" +
            std::to_string(sp.regions_y) + " regions does not fit in the file");
+  // A header whose level count is not the stock's is refused before the grid is allocated
+  // (a short file could otherwise allocate millions of cells first).
+  if (const double n = LbrSolid::level_count(sp); std::isfinite(n) && n != static_cast<double>(levels))
+    r.fail("level count " + std::to_string(levels) + " does not match stock and spacing (" +
+           std::to_string(static_cast<long long>(std::clamp(n, -1e18, 1e18))) + ")");
   LbrSolid solid = [&] {
     try {
-      return LbrSolid(sp);
+      return LbrSolid(sp, LbrSolid::CellsSetLater{});  // every cell is read below
     } catch (const std::invalid_argument& e) {
       r.fail(std::string("bad header: ") + e.what());
       throw;

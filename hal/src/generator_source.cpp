@@ -19,9 +19,10 @@ namespace {
 
 class GeneratorSource final : public Source {
  public:
-  GeneratorSource(std::unique_ptr<SampleGenerator> gen, std::string name, const LiveConfig& cfg, double speed)
+  GeneratorSource(std::unique_ptr<SampleGenerator> gen, std::string name, const LiveConfig& cfg, double speed,
+                  std::uint64_t first_seq)
       : gen_(std::move(gen)), name_(std::move(name)), speed_(speed),
-        period_ns_(static_cast<std::int64_t>(cfg.period_ms * 1e6)), axes_(cfg.axes) {
+        period_ns_(static_cast<std::int64_t>(cfg.period_ms * 1e6)), seq_(first_seq - 1), axes_(cfg.axes) {
     if (axes_.empty()) axes_ = default_axes();
     LiveConfig c;
     c.axes = axes_;
@@ -53,7 +54,9 @@ class GeneratorSource final : public Source {
     s.seq = ++seq_;
     s.mask = 0b111111;
     s.t_rx_ns = sched::now_ns();
-    s.t_src_ns = s.t_rx_ns;
+    // Whole microseconds, strictly increasing: what a recorded frame's TS holds exactly.
+    s.t_src_ns = std::max(s.t_rx_ns / 1000 * 1000, last_src_ns_ + 1000);
+    last_src_ns_ = s.t_src_ns;
     if (record_) record(s, sink);
     sink.on_samples(std::span<const AxisSample>(&s, 1));
     return PollResult::Data;
@@ -69,6 +72,7 @@ class GeneratorSource final : public Source {
   double speed_;
   std::int64_t period_ns_, next_t_ = 0;
   std::uint64_t seq_ = 0;
+  std::int64_t last_src_ns_ = 0;
   bool done_ = false;
   std::vector<AxisMap> axes_;
   int positions_ = 0;
@@ -103,8 +107,8 @@ class GeneratorSource final : public Source {
 }  // namespace
 
 std::unique_ptr<Source> make_generator_source(std::unique_ptr<SampleGenerator> gen, const std::string& name,
-                                              const LiveConfig& cfg, double speed) {
-  return std::make_unique<GeneratorSource>(std::move(gen), name, cfg, speed);
+                                              const LiveConfig& cfg, double speed, std::uint64_t first_seq) {
+  return std::make_unique<GeneratorSource>(std::move(gen), name, cfg, speed, first_seq);
 }
 
 }  // namespace lbr::hal

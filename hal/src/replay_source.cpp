@@ -24,8 +24,8 @@ int hexv(char ch) {
 
 class ReplaySource final : public Source {
  public:
-  ReplaySource(std::string file, const LiveConfig& cfg, double speed)
-      : file_(std::move(file)), cfg_(cfg), speed_(speed), asm_(fill(cfg)) {
+  ReplaySource(std::string file, const LiveConfig& cfg, double speed, std::uint64_t from_byte)
+      : file_(std::move(file)), cfg_(cfg), speed_(speed), from_byte_(from_byte), asm_(fill(cfg)) {
     if (cfg_.axes.empty()) cfg_.axes = default_axes();
     if (!(speed >= 0.0)) throw std::invalid_argument("--speed must be >= 0");
   }
@@ -33,6 +33,8 @@ class ReplaySource final : public Source {
   void open() override {
     std::ifstream in(file_);
     if (!in) throw std::runtime_error(file_ + ": cannot open replay log");
+    if (from_byte_ > 0 && !in.seekg(static_cast<std::streamoff>(from_byte_)))
+      throw std::runtime_error(file_ + ": cannot seek to byte " + std::to_string(from_byte_));
     std::string line;
     int lineno = 0;
     while (std::getline(in, line)) {
@@ -62,7 +64,8 @@ class ReplaySource final : public Source {
       }
       recs_.push_back(r);
     }
-    if (recs_.empty()) throw std::runtime_error(file_ + ": replay log holds no frames");
+    if (recs_.empty() && from_byte_ == 0) throw std::runtime_error(file_ + ": replay log holds no frames");
+    if (recs_.empty()) return;  // a catch-up with nothing after its offset
     t0_log_ = recs_.front().t_ns;
     t0_mono_ = sched::now_ns();
   }
@@ -138,6 +141,7 @@ class ReplaySource final : public Source {
   std::string file_;
   LiveConfig cfg_;
   double speed_;
+  std::uint64_t from_byte_ = 0;
   CanopenAssembler asm_;
   SerialStreamDecoder dec_;
   std::vector<Rec> recs_;
@@ -156,8 +160,9 @@ std::int64_t wall_ns() noexcept {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
-std::unique_ptr<Source> make_replay_source(const std::string& file, const LiveConfig& cfg, double speed) {
-  return std::make_unique<ReplaySource>(file, cfg, speed);
+std::unique_ptr<Source> make_replay_source(const std::string& file, const LiveConfig& cfg, double speed,
+                                           std::uint64_t from_byte) {
+  return std::make_unique<ReplaySource>(file, cfg, speed, from_byte);
 }
 
 }  // namespace lbr::hal

@@ -65,6 +65,13 @@ void SampleStream::flush_all() noexcept {
   for (Channel& c : ch_) flush(c);
 }
 
+void SampleStream::forget_poses() noexcept {
+  for (Channel& c : ch_) {
+    flush(c);
+    c.have = false;
+  }
+}
+
 // The pending run starts afresh at axis values q with the channel's current tool.
 void SampleStream::restart(Channel& c, const kin::Kinematics& k, const nc::AxisVector& q) noexcept {
   c.run.clear();

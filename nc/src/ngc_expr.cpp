@@ -123,12 +123,20 @@ NormalisedLine normalise_line(std::string_view raw) {
 double vacant() { return std::numeric_limits<double>::quiet_NaN(); }
 bool is_vacant(double v) { return std::isnan(v); }
 
-Params::Params() : numbered_(kMaxNumberedParam + 1, 0.0), frames_(1) {}
+Params::Params() : frames_(1) {}
 
 void Params::use_fanuc_variables() {
   fanuc_ = true;
   locals_ = kFanucLocalParams;
   numbered_.assign(numbered_.size(), vacant());
+}
+
+double Params::unset() const { return fanuc_ ? vacant() : 0.0; }
+
+double& Params::slot(int n) {
+  const auto k = static_cast<std::size_t>(n);
+  if (k >= numbered_.size()) numbered_.resize(k + 1, unset());
+  return numbered_[k];
 }
 
 namespace {
@@ -143,14 +151,15 @@ double Params::numbered(int n) const {
   if (fanuc_ && !fanuc_settable(n)) throw ExprError("variable #" + std::to_string(n) + " is not supported " + fanuc_ranges());
   if (n < 1 || n > kMaxNumberedParam)
     throw ExprError("parameter number " + std::to_string(n) + " out of range [1, " + std::to_string(kMaxNumberedParam) + "]");
-  return numbered_[static_cast<std::size_t>(n)];
+  const auto k = static_cast<std::size_t>(n);
+  return k < numbered_.size() ? numbered_[k] : unset();
 }
 
 void Params::set_numbered(int n, double v) {
   if (fanuc_ && !fanuc_settable(n)) throw ExprError("variable #" + std::to_string(n) + " cannot be set " + fanuc_ranges());
   if (n < 1 || n > kMaxNumberedParam)
     throw ExprError("parameter number " + std::to_string(n) + " out of range [1, " + std::to_string(kMaxNumberedParam) + "]");
-  numbered_[static_cast<std::size_t>(n)] = v;
+  slot(n) = v;
 }
 
 bool Params::named_exists(const std::string& name) const {
@@ -176,10 +185,11 @@ void Params::set_named(const std::string& name, double v) {
 
 void Params::push_frame(const std::vector<double>& args) {
   Frame f;
+  (void)slot(locals_);
   for (int i = 0; i < locals_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     f.saved[k] = numbered_[k + 1];
-    numbered_[k + 1] = k < args.size() ? args[k] : fanuc_ ? vacant() : 0.0;
+    numbered_[k + 1] = k < args.size() ? args[k] : unset();
   }
   frames_.push_back(std::move(f));
 }

@@ -70,6 +70,13 @@ class Params {
     std::array<double, kFanucLocalParams> saved{};
     std::map<std::string, double> locals;
   };
+  // The value of a parameter never set: 0 (RS274/NGC) or <vacant> (Fanuc).
+  [[nodiscard]] double unset() const;
+  // Parameter n's storage, growing the table to n (new entries unset()). The table holds only
+  // up to the highest parameter set so far: a program that sets none allocates none (reading
+  // one beyond the table gives unset()), instead of #0..#5602 per interpreter.
+  double& slot(int n);
+
   std::vector<double> numbered_;
   std::map<std::string, double> globals_;
   std::vector<Frame> frames_;

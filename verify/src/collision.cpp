@@ -54,7 +54,7 @@ const nc::Segment* MoveIndex::find(geom::MoveId id, const std::string** source) 
 }
 
 CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::ToolTable& tools, const MoveIndex& index)
-    : config_(config), tools_(tools), index_(index) {
+    : config_(config), index_(index) {
   for (const auto& [number, tool] : tools.config().tools) {
     Parts p;
     p.shank_from_mm = tool.flute_length_mm + config.tolerance_mm;

@@ -4,11 +4,14 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <map>
 #include <sstream>
+
+#include "geom/units.hpp"
 
 namespace lbr::verify {
 
@@ -16,21 +19,31 @@ namespace {
 
 constexpr std::size_t kHeaderBytes = 84, kTriangleBytes = 50;
 
+// A coordinate the kernel can hold: finite and within geom's safe range (±107 m). NaN, inf
+// and huge values were accepted before and reached the slicer (found by fuzz_stl).
+bool usable(double v) noexcept { return std::isfinite(v) && std::abs(v) <= geom::kSafeRangeMm; }
+std::string range_text() { return "a finite coordinate within ±" + std::to_string(static_cast<long>(geom::kSafeRangeMm)) + " mm"; }
+
 float read_f32(const char* p) noexcept {
   float f;
   std::memcpy(&f, p, 4);  // little-endian hosts only (x86-64, aarch64)
   return f;
 }
 
-StlMesh parse_binary(std::string_view b) {
+StlMesh parse_binary(std::string_view b, const std::string& name) {
   std::uint32_t n = 0;
   std::memcpy(&n, b.data() + 80, 4);
   StlMesh m;
   m.triangles.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) {
-    const char* p = b.data() + kHeaderBytes + std::size_t{i} * kTriangleBytes + 12;  // skip the normal
-    for (int k = 0; k < 3; ++k)
-      m.triangles[i].v[k] = {read_f32(p + 12 * k), read_f32(p + 12 * k + 4), read_f32(p + 12 * k + 8)};
+    const std::size_t at = kHeaderBytes + std::size_t{i} * kTriangleBytes + 12;  // skip the normal
+    for (int k = 0; k < 3; ++k) {
+      geom::Vec3& v = m.triangles[i].v[k];
+      v = {read_f32(b.data() + at + 12 * k), read_f32(b.data() + at + 12 * k + 4), read_f32(b.data() + at + 12 * k + 8)};
+      if (!usable(v.x) || !usable(v.y) || !usable(v.z))
+        throw StlError(name + ": at byte " + std::to_string(at + 12 * k) + ": triangle " + std::to_string(i + 1) +
+                       ", vertex " + std::to_string(k + 1) + ": expected " + range_text());
+    }
   }
   return m;
 }
@@ -73,6 +86,12 @@ double number(Words& w, const std::string& name) {
   return v;
 }
 
+double coordinate(Words& w, const std::string& name) {
+  const double v = number(w, name);
+  if (!usable(v)) throw StlError(name + ":" + std::to_string(w.line()) + ": expected " + range_text());
+  return v;
+}
+
 StlMesh parse_ascii(std::string_view s, const std::string& name) {
   Words w(s);
   expect(w, "solid", name);
@@ -91,9 +110,9 @@ StlMesh parse_ascii(std::string_view s, const std::string& name) {
     Triangle t;
     for (geom::Vec3& v : t.v) {
       expect(w, "vertex", name);
-      v.x = number(w, name);
-      v.y = number(w, name);
-      v.z = number(w, name);
+      v.x = coordinate(w, name);
+      v.y = coordinate(w, name);
+      v.z = coordinate(w, name);
     }
     expect(w, "endloop", name);
     expect(w, "endfacet", name);
@@ -121,7 +140,7 @@ StlMesh parse_stl(std::string_view bytes, const std::string& name) {
   if (bytes.size() >= kHeaderBytes) {
     std::uint32_t n = 0;
     std::memcpy(&n, bytes.data() + 80, 4);
-    if (bytes.size() == kHeaderBytes + std::size_t{n} * kTriangleBytes) return parse_binary(bytes);
+    if (bytes.size() == kHeaderBytes + std::size_t{n} * kTriangleBytes) return parse_binary(bytes, name);
   }
   if (bytes.substr(0, 5) == "solid") return parse_ascii(bytes, name);
   throw StlError(name + ": expected an STL file: binary (84 + 50 bytes a triangle; this file has " +

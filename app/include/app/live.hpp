@@ -116,6 +116,9 @@ struct LiveResult {
   std::uint64_t events_dropped = 0, event_latency_count = 0;
   double event_latency_p50_ms = 0, event_latency_p99_ms = 0, event_latency_max_ms = 0;
   double check_p50_ms = 0, check_p99_ms = 0, check_max_ms = 0;
+  // Power-loss catch-up (docs/snapshot.md): samples applied at start from the --record file
+  // after the snapshot's position, and recorded ones skipped there because the solid held them.
+  std::uint64_t samples_caught_up = 0, catch_up_skipped = 0;
 };
 
 using StatusFn = std::function<void(const std::string& line)>;

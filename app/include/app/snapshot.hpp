@@ -1,9 +1,10 @@
 // app/snapshot.hpp — power-loss snapshots of a live run (docs/snapshot.md has the format).
 //
 // A snapshot holds the stock (the LBRS level file of geom/serialize.hpp), where the source
-// was (the source's sample number of the newest sample in the solid), how far the --record
-// file had been written, and each channel's newest applied sample (the start of the next
-// sweep). Two files alternate in the snapshot folder (snapshot-a.lbrsnap, snapshot-b.lbrsnap);
+// was (the source's sample number of the newest sample in the solid), the --record file and
+// an offset in it from which the samples not in the solid can be replayed (catch-up), and
+// each channel's newest applied sample (the start of the next sweep; its sender time tells
+// which recorded samples the solid holds). Two files alternate in the snapshot folder (snapshot-a.lbrsnap, snapshot-b.lbrsnap);
 // each is written to a temporary file, fsync'd and renamed over the older one, so a power
 // cut leaves at least one complete snapshot. On start the newest valid one is used; a
 // corrupt or truncated one is reported and the other used.
@@ -25,6 +26,11 @@
 
 namespace lbr::app {
 
+// Power-loss catch-up: a snapshot's record offset is where the recording stood at least this
+// long (receive time) before the newest applied sample, so that every sample still in
+// flight then (a CAN cycle being assembled, a queue behind the geometry thread) is after it.
+inline constexpr std::int64_t kCatchUpMarginNs = 1'000'000'000;
+
 // A 1 mm cube of one level and one region: what SnapshotState holds until a solid is assigned.
 [[nodiscard]] geom::SolidSpec placeholder_solid_spec();
 
@@ -32,10 +38,15 @@ struct SnapshotState {
   std::uint64_t generation = 0;       // written count; the higher of two valid files wins
   std::uint64_t source_position = 0;  // source's sample number (1, 2, …) of the newest sample in the solid
   std::uint64_t samples_applied = 0;  // samples applied since the run first started (coalesced included)
-  std::uint64_t record_offset = 0;    // bytes of the --record file that held these samples (0: no recording)
+  // Power-loss catch-up: the --record file (empty: none) and a line boundary in it from which
+  // every sample not in the solid can be replayed (the recording as it was at least
+  // kCatchUpMarginNs of receive time before the newest applied sample; earlier ones are
+  // skipped by sender time, SkipSink).
+  std::uint64_t record_offset = 0;
+  std::string record_file;
   double wall_time_s = 0;             // time the run had been going (all resumed parts together) [s]
   std::string source;                 // --source spec of the run
-  // Newest applied sample of each channel (have[i] false: none yet).
+  // Newest applied sample of each channel (have[i] false: none yet), with its sender time.
   std::array<bool, hal::kMaxChannels> have{};
   std::array<hal::AxisSample, hal::kMaxChannels> last{};
   geom::LbrSolid solid{placeholder_solid_spec()};

@@ -92,6 +92,13 @@ class Geometry final : public motion::SweepSink {
   // the motion stream with them so the next sample sweeps from where the tool was. prime()
   // is setup (before the thread starts); last_applied() is read on the geometry thread.
   void prime(const std::array<bool, hal::kMaxChannels>& have, const std::array<hal::AxisSample, hal::kMaxChannels>& last) noexcept;
+  // A break in the stream (a live source after the outage, once the catch-up from the
+  // recording is applied): the next sample of each channel sweeps from nowhere. The newest
+  // applied samples stay (the snapshot's). Setup, between tick()s on the thread that ticks.
+  void forget_poses() noexcept {
+    stream_.forget_poses();
+    stream_.clear_batch();
+  }
   [[nodiscard]] const std::array<bool, hal::kMaxChannels>& have_applied() const noexcept { return have_; }
   [[nodiscard]] const std::array<hal::AxisSample, hal::kMaxChannels>& last_applied() const noexcept { return last_; }
 

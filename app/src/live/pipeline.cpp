@@ -3,10 +3,15 @@
 //   hal_thread()       source.poll → RingSink (validate → ring)          RT, highest
 //   geometry_thread()  Geometry::tick → publish to the render side       RT
 //   recorder_thread()  raw records → the --record file                   non-RT
+#include <unistd.h>
+
+#include <array>
 #include <chrono>
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -18,6 +23,7 @@
 #include "live/geometry.hpp"
 #include "live/ring_sink.hpp"
 #include "live/source.hpp"
+#include <spdlog/spdlog.h>
 #include "motion/tool_table.hpp"
 #include "sched/rt_thread.hpp"
 #include "sched/spsc_ring.hpp"
@@ -48,13 +54,26 @@ struct LivePipeline::Impl {
   std::unique_ptr<live::LiveChecks> checks;  // collision checks on the geometry thread (null: off)
   std::shared_ptr<const nc::Emulator> emulator;        // an emulator source's (its plan)
   std::unique_ptr<live::ProgramPosition> position;     // line, machining time for the status bar
-  // Power-loss snapshots (app/snapshot.hpp): the writer, its period, and where a resumed
-  // run started (the source's sample numbers restart at 1 after an emulator skip).
+  // Power-loss snapshots (app/snapshot.hpp): the writer, its period, and the counters of
+  // the resumed parts before this run.
   std::unique_ptr<SnapshotWriter> snap;
   std::int64_t snapshot_period_ns = 0;
-  std::uint64_t seq_base = 0, applied_base = 0;
+  std::uint64_t applied_base = 0;
   double wall_base_s = 0;
   std::atomic<std::uint64_t> rec_bytes{0};  // written to the --record file so far
+  // Catch-up offsets (docs/snapshot.md): where the --record file stood at a time (geometry
+  // thread, every kRecMarkEveryNs; the newest kRecMarks), the file when this run started,
+  // and its absolute path as snapshots name it.
+  struct RecMark {
+    std::int64_t t_ns = 0;
+    std::uint64_t bytes = 0;
+  };
+  static constexpr std::size_t kRecMarks = 64;
+  std::array<RecMark, kRecMarks> rec_marks{};
+  std::size_t rec_marks_n = 0;
+  RecMark rec_start;
+  std::int64_t next_mark_ns = 0;
+  std::string rec_path;
   std::atomic<std::int64_t> snapshot_copy_max_ns{0};  // longest copy of the solid on the geometry thread
 
   // start() .. stop()
@@ -83,8 +102,12 @@ std::size_t write_record_line(std::FILE* f, const hal::RawRecord& r, const std::
   if (r.serial) {
     const long long sec = r.t_wall_ns / 1'000'000'000, usec = (r.t_wall_ns % 1'000'000'000) / 1000;
     int n = std::snprintf(line, sizeof line, "(%010lld.%06lld) serial #", sec, usec);
-    for (std::uint16_t i = 0; i < r.len && n + 3 < static_cast<int>(sizeof line); ++i)
-      n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), "%02X", r.bytes[i]);
+    static constexpr char kHex[] = "0123456789ABCDEF";  // not snprintf per byte: the recorder keeps up at 40 kHz
+    for (std::uint16_t i = 0; i < r.len && n + 3 < static_cast<int>(sizeof line); ++i) {
+      line[n++] = kHex[r.bytes[i] >> 4];
+      line[n++] = kHex[r.bytes[i] & 15];
+    }
+    line[n] = '\0';
     std::fputs(line, f);
     std::fputc('\n', f);
     return static_cast<std::size_t>(n) + 1;
@@ -94,6 +117,22 @@ std::size_t write_record_line(std::FILE* f, const hal::RawRecord& r, const std::
   const std::size_t n = hal::format_candump_line(fr, iface, line);
   std::fwrite(line, 1, n, f);
   return n;
+}
+
+// Bytes of `path` up to and including its last newline (0 when it does not exist); a longer
+// file is cut there. Setup.
+std::uint64_t complete_lines_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return 0;
+  const auto size = static_cast<std::uint64_t>(in.tellg());
+  std::uint64_t keep = size;
+  char ch = '\n';
+  while (keep > 0 && in.seekg(static_cast<std::streamoff>(keep - 1)) && in.get(ch) && ch != '\n') --keep;
+  if (keep < size) {
+    spdlog::warn("{}: cutting an unfinished last line ({} bytes) before appending", path, size - keep);
+    std::filesystem::resize_file(path, keep);
+  }
+  return keep;
 }
 
 // Counters for the HUD, read on the geometry thread when it publishes (reads of counters
@@ -137,19 +176,40 @@ constexpr std::int64_t kStopGraceNs = 250'000'000;
 
 void bump(std::atomic<std::uint64_t>& c) noexcept { c.store(c.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
 
+constexpr std::int64_t kRecMarkEveryNs = 250'000'000;
+
+// Geometry thread: notes where the --record file stands now (every kRecMarkEveryNs).
+void mark_recording(LivePipeline::Impl& p, std::int64_t now_ns) noexcept {
+  if (p.rec_path.empty() || now_ns < p.next_mark_ns) return;
+  p.rec_marks[p.rec_marks_n++ % p.rec_marks.size()] = {now_ns, p.rec_bytes.load(std::memory_order_relaxed)};
+  p.next_mark_ns = now_ns + kRecMarkEveryNs;
+}
+
+// Where a catch-up must start to find every sample not in the solid: the newest mark at least
+// kCatchUpMarginNs before the newest applied sample was received (records written by then
+// belong to samples received before it, which the geometry thread applied in order), else
+// where this run started recording. Recorded samples before the solid's are skipped by time.
+std::uint64_t catch_up_offset(const LivePipeline::Impl& p) noexcept {
+  const std::int64_t limit = p.geo->last_rx_ns() - kCatchUpMarginNs;
+  LivePipeline::Impl::RecMark best = p.rec_start;
+  for (std::size_t i = 0; i < std::min(p.rec_marks_n, p.rec_marks.size()); ++i) {
+    const LivePipeline::Impl::RecMark& m = p.rec_marks[i];
+    if (m.t_ns <= limit && m.t_ns > best.t_ns) best = m;
+  }
+  return best.bytes;
+}
+
 // What a snapshot records besides the solid (the geometry thread's state at a batch boundary).
 void fill_snapshot(const LivePipeline::Impl& p, SnapshotState& s) {
   s.source = p.opt.source;
   s.have = p.geo->have_applied();
   s.last = p.geo->last_applied();
-  s.source_position = p.seq_base;
-  for (int c = 0; c < hal::kMaxChannels; ++c) {
-    if (!s.have[c]) continue;
-    s.last[c].seq += p.seq_base;  // the source's numbering from its start
-    s.source_position = std::max(s.source_position, s.last[c].seq);
-  }
+  s.source_position = 0;
+  for (int c = 0; c < hal::kMaxChannels; ++c)
+    if (s.have[c]) s.source_position = std::max(s.source_position, s.last[c].seq);
   s.samples_applied = p.applied_base + p.geo->applied();
-  s.record_offset = p.rec_bytes.load(std::memory_order_relaxed);
+  s.record_file = p.rec_path;
+  s.record_offset = p.rec_path.empty() ? 0 : catch_up_offset(p);
   s.wall_time_s = p.wall_base_s + static_cast<double>(sched::now_ns() - p.t0) * 1e-9;
 }
 
@@ -178,6 +238,7 @@ void geometry_thread(LivePipeline::Impl& p) {
   p.progress->geometry_running.store(true, std::memory_order_relaxed);
   for (;;) {
     bump(p.progress->geometry_loops);
+    mark_recording(p, sched::now_ns());
     const bool finished = p.hal_done.load(std::memory_order_acquire);
     const std::int64_t t_tick = sched::now_ns();
     if (p.geo->stop_due()) break;
@@ -239,15 +300,27 @@ void hal_thread(LivePipeline::Impl& p) {
 
 // Recorder thread (--record): writes the raw records as candump -l lines until the HAL
 // thread is done and the ring is empty.
+// Each drained batch is flushed to the kernel (a crashed process loses at most the lines not
+// yet drained), and fdatasync'd every second (a power cut loses about a second of it): the
+// catch-up after a restart replays what the file holds.
 void recorder_thread(LivePipeline::Impl& p) {
+  std::int64_t next_sync_ns = sched::now_ns() + 1'000'000'000;
   for (;;) {
     const bool finished = p.hal_done.load(std::memory_order_acquire);
     bool any = false;
+    std::uint64_t bytes = 0;
     while (hal::RawRecord* rec = p.rec_ring->front()) {
-      const std::size_t n = write_record_line(p.rec_file, *rec, p.rec_iface);
-      p.rec_bytes.store(p.rec_bytes.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
+      bytes += write_record_line(p.rec_file, *rec, p.rec_iface);
       p.rec_ring->pop();
       any = true;
+    }
+    if (any) {
+      std::fflush(p.rec_file);  // before the bytes count as written
+      p.rec_bytes.store(p.rec_bytes.load(std::memory_order_relaxed) + bytes, std::memory_order_relaxed);
+    }
+    if (any && sched::now_ns() >= next_sync_ns) {
+      (void)::fdatasync(fileno(p.rec_file));
+      next_sync_ns = sched::now_ns() + 1'000'000'000;
     }
     if (finished && !any) break;
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -335,8 +408,7 @@ void configure_program(LivePipeline::Impl& p) {
   std::optional<nc::Toolpath> program;
   if (!p.opt.program.empty() && !p.emulator) program = load_toolpath(p.opt.program, p.profile);
   p.position = std::make_unique<live::ProgramPosition>(p.emulator, program ? &*program : nullptr,
-                                                       live_emulator_limits(p.profile), p.profile.live.period_ms * 1e-3,
-                                                       p.seq_base);
+                                                       live_emulator_limits(p.profile), p.profile.live.period_ms * 1e-3);
   p.geo->set_program_position(p.position.get());
 }
 
@@ -344,6 +416,55 @@ geom::SolidSpec live_solid_spec(const Profile& profile, const motion::ToolTable&
   geom::SolidSpec spec = profile.solid;
   if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tools.max_diameter());
   return spec;
+}
+
+// The --record file: a new part truncates it; a resumed one appends (snapshot offsets stay
+// file offsets), after cutting a last line that a crash left unfinished.
+void open_recording(LivePipeline::Impl& p, bool resumed) {
+  if (p.opt.record.empty()) return;
+  p.rec_path = std::filesystem::absolute(p.opt.record).lexically_normal().string();
+  std::uint64_t size = 0;
+  if (resumed) size = complete_lines_size(p.opt.record);
+  p.rec_file = std::fopen(p.opt.record.c_str(), resumed ? "a" : "w");
+  if (p.rec_file == nullptr) throw std::runtime_error(p.opt.record + ": cannot open for writing");
+  p.rec_bytes.store(size, std::memory_order_relaxed);
+  p.rec_start = {std::numeric_limits<std::int64_t>::min(), size};
+}
+
+// Power-loss catch-up (docs/snapshot.md): the samples that the --record file holds after the
+// snapshot's offset and the solid does not (SkipSink by sender time) are replayed through the
+// validation, the ring and Geometry::tick like any other samples — on the calling thread,
+// before the threads start, in chunks of batch_moves as a replay as fast as possible.
+void catch_up(LivePipeline::Impl& p, const SnapshotState& snap) {
+  const std::uint64_t size = p.rec_bytes.load(std::memory_order_relaxed);
+  if (p.rec_path.empty() || snap.record_file != p.rec_path || snap.record_offset >= size) return;
+  // The emulator computes the samples after the snapshot again, with their tools; its
+  // recording (serial frames) has no tool numbers, so it is not replayed.
+  if (p.opt.source.rfind("emulator:", 0) == 0) return;
+  std::unique_ptr<hal::Source> src;
+  try {
+    src = hal::make_replay_source(p.opt.record, p.profile.live, 0.0, snap.record_offset);
+    src->open();
+  } catch (const std::exception& e) {
+    p.r->warnings.push_back(std::string("no catch-up from the recording: ") + e.what());
+    return;
+  }
+  const std::atomic<bool> never{false};
+  RingSink sink(*p.ring, nullptr, p.profile.live, true, never, p.opt.overflow_capacity);
+  live::SkipSink skip(sink, 0);
+  skip.skip_by_time(snap.have, snap.last);
+  const std::uint64_t before = p.geo->applied();
+  constexpr std::size_t kRoom = 64;  // samples one poll of a replay can deliver at most (4 serial frames x 4 channels + margin)
+  bool more = true;
+  while (more || p.ring->size() > 0) {
+    while (more && p.ring->capacity() - p.ring->size() >= std::min(kRoom, p.ring->capacity()))
+      more = src->poll(0, skip) != hal::PollResult::End;
+    (void)p.geo->tick(static_cast<std::size_t>(p.profile.batch_moves));
+  }
+  p.r->samples_caught_up = p.geo->applied() - before;
+  p.r->catch_up_skipped = skip.skipped();
+  spdlog::info("resume: caught up {} samples from {} after byte {} ({} recorded ones already in the part)",
+               p.r->samples_caught_up, p.opt.record, snap.record_offset, p.r->catch_up_skipped);
 }
 
 }  // namespace
@@ -370,22 +491,29 @@ void LivePipeline::configure() {
   const SnapshotState* resume = p.opt.resume;
   if (resume != nullptr) resume_from(p, *resume);
   const bool emulator = p.opt.source.rfind("emulator:", 0) == 0, replay = p.opt.source.rfind("replay:", 0) == 0;
-  p.seq_base = resume != nullptr && emulator ? resume->source_position : 0;
   start_snapshots(p);
 
-  p.src = live::make_source(profile, p.opt.source, p.opt.speed, p.seq_base, &p.emulator);
+  p.ring = std::make_unique<sched::SpscRing<hal::AxisSample>>(cfg.ring_capacity);
+  open_recording(p, resume != nullptr);
+  p.geo = std::make_unique<Geometry>(p.r->solid, profile, *p.tools, cfg.tool, *p.ring, cfg.merge_tolerance_mm);
+  p.geo->set_stop(&p.external_stop, &p.stop_requested, &p.stop_ns, kStopGraceNs);
+  p.geo->set_kernel_delay_ns(p.opt.test_kernel_delay_ns);
+  if (p.opt.test_work_budget > 0) p.geo->set_work_budget(p.opt.test_work_budget);
+  std::uint64_t position = 0;  // the emulator's samples in the solid (it computes and skips them)
+  if (resume != nullptr) {
+    p.geo->prime(resume->have, resume->last);  // the recorded stream goes on from these poses
+    catch_up(p, *resume);
+    position = resume->source_position;
+    for (int c = 0; c < hal::kMaxChannels; ++c)
+      if (p.geo->have_applied()[c]) position = std::max(position, p.geo->last_applied()[c].seq);
+    // A live machine has moved on during the outage: no sweep across it.
+    if (!emulator && !replay) p.geo->forget_poses();
+  }
+
+  p.src = live::make_source(profile, p.opt.source, p.opt.speed, emulator ? position : 0, &p.emulator);
   p.src->open();
   p.backpressure = !p.src->live();
-  p.ring = std::make_unique<sched::SpscRing<hal::AxisSample>>(cfg.ring_capacity);
-  if (!p.opt.record.empty()) {
-    // Resumed: the recording goes on in the same file, so snapshot offsets stay file offsets.
-    p.rec_file = std::fopen(p.opt.record.c_str(), resume != nullptr ? "a" : "w");
-    if (p.rec_file == nullptr) throw std::runtime_error(p.opt.record + ": cannot open for writing");
-    if (resume != nullptr) {
-      std::error_code ec;
-      const auto size = std::filesystem::file_size(p.opt.record, ec);
-      p.rec_bytes.store(ec ? 0 : static_cast<std::uint64_t>(size), std::memory_order_relaxed);
-    }
+  if (p.rec_file != nullptr) {
     p.rec_ring = std::make_unique<sched::SpscRing<hal::RawRecord>>(1 << 15);
     p.src->set_recording(true);
   }
@@ -393,25 +521,16 @@ void LivePipeline::configure() {
   p.sink = std::make_unique<RingSink>(*p.ring, p.rec_ring.get(), cfg, p.backpressure, p.stop_requested,
                                       p.opt.overflow_capacity);
   p.input = p.sink.get();
-  if (resume != nullptr && replay) {
+  if (resume != nullptr && replay) {  // the log from its start: what the solid holds is skipped
     p.skip_sink = std::make_unique<live::SkipSink>(*p.sink, resume->source_position);
+    p.skip_sink->skip_by_time(p.geo->have_applied(), p.geo->last_applied());
     p.input = p.skip_sink.get();
   }
-  p.geo = std::make_unique<Geometry>(p.r->solid, profile, *p.tools, cfg.tool, *p.ring, cfg.merge_tolerance_mm);
   if (profile.checks.enabled) {
     p.checks = std::make_unique<live::LiveChecks>(profile, *p.tools, Geometry::batch_capacity(p.ring->capacity()),
-                                                  live::ProgramLines(p.emulator, emulator ? p.opt.source.substr(9) : "",
-                                                                     p.seq_base));
+                                                  live::ProgramLines(p.emulator, emulator ? p.opt.source.substr(9) : ""));
     p.geo->set_checks(p.checks.get());
   }
-  if (resume != nullptr && (emulator || replay)) {  // a live machine has moved on: no sweep across the outage
-    std::array<hal::AxisSample, hal::kMaxChannels> last = resume->last;
-    for (hal::AxisSample& s : last) s.seq = s.seq >= p.seq_base ? s.seq - p.seq_base : 0;
-    p.geo->prime(resume->have, last);
-  }
-  p.geo->set_stop(&p.external_stop, &p.stop_requested, &p.stop_ns, kStopGraceNs);
-  p.geo->set_kernel_delay_ns(p.opt.test_kernel_delay_ns);
-  if (p.opt.test_work_budget > 0) p.geo->set_work_budget(p.opt.test_work_budget);
   p.geo->set_exchange(p.opt.exchange);
   configure_program(p);
   if (p.opt.on_start) p.opt.on_start(p.r->solid);

@@ -27,9 +27,10 @@ class ProgramPosition {
  public:
   // `emulator`: the emulator source's (shared with the HAL thread, which only advances its
   // sample counter; this side reads its plan). `program`: --program's tool path. `period_s`:
-  // the live sample period; `seq_base`: samples a resumed emulator skipped.
+  // the live sample period. Sample numbers are absolute (a resumed emulator numbers on from
+  // the samples it skipped).
   ProgramPosition(std::shared_ptr<const nc::Emulator> emulator, const nc::Toolpath* program,
-                  const nc::EmulatorLimits& limits, double period_s, std::uint64_t seq_base);
+                  const nc::EmulatorLimits& limits, double period_s);
 
   // Every applied sample (channel 0 counts; others are ignored).
   void on_sample(const hal::AxisSample& s) noexcept;
@@ -39,7 +40,7 @@ class ProgramPosition {
   std::shared_ptr<const nc::Emulator> emu_;
   std::optional<nc::LineTracker> tracker_;
   double period_s_ = 0, total_s_ = -1;
-  std::uint64_t seq_base_ = 0, first_seq_ = 0, seq_ = 0;
+  std::uint64_t first_seq_ = 0, seq_ = 0;
   int line_ = -1;
 };
 

@@ -40,14 +40,15 @@ std::unique_ptr<hal::Source> make_emulator_source(const Profile& profile, const 
                                " is not in the tool table of " + profile.source);
   auto emu = std::make_shared<nc::Emulator>(path, live_emulator_limits(profile));
   if (shared != nullptr) *shared = emu;
-  return hal::make_generator_source(std::make_unique<EmulatorGenerator>(std::move(emu), skip), arg, profile.live, speed);
+  return hal::make_generator_source(std::make_unique<EmulatorGenerator>(std::move(emu), skip), arg, profile.live, speed,
+                                    skip + 1);
 }
 
 }  // namespace
 
 int ProgramLines::line_of(std::uint64_t seq) const noexcept {
   if (!emu_ || seq == 0) return 0;
-  const double t = static_cast<double>(skip_ + seq) * emu_->period_s();
+  const double t = static_cast<double>(seq) * emu_->period_s();
   if (t > emu_->total_time_s() + emu_->period_s()) return 0;
   return emu_->line_at(t);
 }

@@ -136,6 +136,15 @@ class LbrSolid {
   // Setup: allocates all cells. Throws std::invalid_argument with a precise message when the
   // spec is unusable (non-positive sizes, out of the safe range, too many levels/regions).
   explicit LbrSolid(const SolidSpec& spec);
+  // The same grid and initial_volume_mm3(), but every cell is left empty for the caller to
+  // set (set_cell) — the levels file reader, which replaces every cell: building the stock's
+  // levels first cost up to levels x regions copies of a 4096-gon it then threw away.
+  struct CellsSetLater {};
+  LbrSolid(const SolidSpec& spec, CellsSetLater);
+  // Levels the spec's stock height and spacing give (NaN or out of range for a bad spec; the
+  // constructor checks). Lets the levels file reader refuse a header whose level count
+  // disagrees before the grid is allocated.
+  [[nodiscard]] static double level_count(const SolidSpec& spec) noexcept;
   ~LbrSolid();
   LbrSolid(LbrSolid&&) noexcept;
   LbrSolid& operator=(LbrSolid&&) noexcept;
@@ -204,7 +213,10 @@ class LbrSolid {
 
  private:
   friend class detail::SubtractEngine;  // reads the grid, writes cells and dirty flags
-  void init_cells();
+  LbrSolid(const SolidSpec& spec, bool fill);
+  void init_cells(bool fill);  // grid, initial volume; fill: every cell holds the stock
+  [[nodiscard]] Path stock_circle() const;  // the cylinder polygonised (empty for a box)
+  [[nodiscard]] std::vector<Polygon> stock_polygons(int region, const Path& circle) const;
 
   SolidSpec spec_;
   int levels_ = 0;

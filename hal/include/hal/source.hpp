@@ -97,11 +97,17 @@ class SampleGenerator {
 
 // Factories. `speed` applies to replay (1 = real time, 0 = as fast as possible) and to the
 // generator (same meaning). Throw std::runtime_error / std::invalid_argument on bad specs.
+// Replay: `from_byte` starts reading the log there (a line boundary; power-loss catch-up
+// replays the --record file from a snapshot's offset); errors then name lines counted from it.
+// Generator: its samples are numbered first_seq, first_seq + 1, … (a resumed emulator goes on
+// with the numbers of the samples it skipped), and its sender times (t_src_ns) are whole
+// microseconds, strictly increasing, so that a --record file holds them exactly.
 [[nodiscard]] std::unique_ptr<Source> make_serial_source(const std::string& device, const LiveConfig& cfg);
 [[nodiscard]] std::unique_ptr<Source> make_socketcan_source(const std::string& iface, const LiveConfig& cfg);
-[[nodiscard]] std::unique_ptr<Source> make_replay_source(const std::string& file, const LiveConfig& cfg, double speed);
+[[nodiscard]] std::unique_ptr<Source> make_replay_source(const std::string& file, const LiveConfig& cfg, double speed,
+                                                         std::uint64_t from_byte = 0);
 [[nodiscard]] std::unique_ptr<Source> make_generator_source(std::unique_ptr<SampleGenerator> gen, const std::string& name,
-                                                            const LiveConfig& cfg, double speed);
+                                                            const LiveConfig& cfg, double speed, std::uint64_t first_seq = 1);
 
 // CLOCK_REALTIME [ns].
 [[nodiscard]] std::int64_t wall_ns() noexcept;

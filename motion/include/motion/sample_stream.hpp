@@ -66,6 +66,9 @@ class SampleStream {
   void take(int channel, std::uint64_t seq, int tool, std::span<const double> q, std::uint32_t mask) noexcept;
   // Ends every channel's pending run into the batch (at the end of a geometry tick).
   void flush_all() noexcept;
+  // flush_all(), then every channel forgets where it was: its next sample is a pose, not the
+  // end of a sweep (a break in the stream, e.g. a live machine after an outage).
+  void forget_poses() noexcept;
   [[nodiscard]] std::span<const geom::SweepRef> batch() const noexcept { return batch_; }
   [[nodiscard]] std::span<const SweepInfo> batch_info() const noexcept { return info_; }
   void clear_batch() noexcept {

@@ -116,7 +116,6 @@ class CollisionChecker {
   [[nodiscard]] Event event_of(const motion::TimedSweep& m, const Finding& f) const;
 
   CheckConfig config_;
-  const motion::ToolTable& tools_;
   const MoveIndex& index_;
   std::map<int, Parts> parts_;
   IntrusionProbe probe_;
