@@ -127,25 +127,31 @@ struct Hull3 {
     return bp;
   }
   // Boundary point of the section of the hull by z = zc in in-plane direction (cos φ, sin φ),
-  // to about `eps` [mm]. The point is interpolated on the chord between the support points
-  // below and above the plane; the bisection on the tilt halves its distance to the
-  // boundary each step, so it stops once a step moves the point by less than eps/2 (the
-  // steps left would move it by about as much in all).
-  P2 section_point(double phi, double zc, double eps) const noexcept {
+  // to about `eps` [mm]: the support point of the section in that direction. The point is
+  // interpolated on the chord between the support points below and above the plane (inside
+  // the hull, so never outside the section); the bisection on the tilt t of the 3D
+  // direction (cos φ, sin φ, t) halves its distance to the boundary each step, so it stops
+  // once a step moves the point by less than eps/2 (the steps left would move it by about
+  // as much in all). The search starts from [t_lo, t_hi] (a neighbouring direction's
+  // bracket: the tilt changes little between close directions), widened until it brackets
+  // the plane; `t_lo`/`t_hi` return the final bracket.
+  P2 section_point(double phi, double zc, double eps, double& t_lo, double& t_hi) const noexcept {
     const double ux = std::cos(phi), uy = std::sin(phi);
     auto sup = [&](double t) { return support(Vec3{ux, uy, t}); };
-    double tlo = -1.0, thi = 1.0;
+    double tlo = t_lo, thi = t_hi;
     Vec3 plo = sup(tlo), phi_ = sup(thi);
     for (int i = 0; i < 80 && plo.z > zc; ++i) {
+      const double w = thi - tlo;
       thi = tlo;
       phi_ = plo;
-      tlo *= 2.0;
+      tlo -= 2.0 * w + 1e-9;
       plo = sup(tlo);
     }
     for (int i = 0; i < 80 && phi_.z < zc; ++i) {
+      const double w = thi - tlo;
       tlo = thi;
       plo = phi_;
-      thi *= 2.0;
+      thi += 2.0 * w + 1e-9;
       phi_ = sup(thi);
     }
     auto interpolate = [&] {
@@ -171,6 +177,8 @@ struct Hull3 {
       last = now;
       if (i >= 4 && dx * dx + dy * dy <= stop2) break;
     }
+    t_lo = tlo;
+    t_hi = thi;
     return last;
   }
 };
@@ -617,9 +625,67 @@ const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {
   return c;
 }
 
+namespace {
+
+// The boundary of the section of `hull` on z = zc, as support points in angular order
+// (counter-clockwise) appended to sc.pts. Between the support points a and b of directions
+// φa < φb the boundary lies in the triangle of the chord ab and the two support lines
+// (convexity), whose height over the chord is at most |ab|/2 · tan((φb − φa)/2) (base
+// angles summing to φb − φa). An interval is split at its middle direction until that
+// bound is within tol/2, so every vertex is evaluated once and kept; a middle point on the
+// chord (within the point accuracy) proves the boundary straight there (the support line
+// through it holds a and b) and ends the split as well.
+void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc) {
+  constexpr double kPointEps = 0.05;  // boundary points to tol/20
+  constexpr int kStart = 16;
+  constexpr int kMaxPoints = 8192;
+  const double eps = kPointEps * tol;
+  struct Iv {
+    double pa, pb;
+    P2 a, b;
+    double ta_lo, ta_hi, tb_lo, tb_hi;
+    int depth;
+  };
+  sc.dirs.clear();
+  double tlo = -1.0, thi = 1.0;
+  for (int i = 0; i < kStart; ++i) {
+    const double phi = 2.0 * std::numbers::pi * i / kStart;
+    const P2 p = hull.section_point(phi, zc, eps, tlo, thi);
+    sc.dirs.push_back({phi, p, tlo, thi});
+  }
+  sc.pts.clear();
+  for (int i = 0; i < kStart; ++i) {
+    const int j = (i + 1) % kStart;
+    Iv stack[64];
+    int sp = 0;
+    stack[sp++] = {sc.dirs[i].phi, sc.dirs[i].phi + 2.0 * std::numbers::pi / kStart, sc.dirs[i].p, sc.dirs[j].p,
+                   sc.dirs[i].t_lo, sc.dirs[i].t_hi, sc.dirs[j].t_lo, sc.dirs[j].t_hi, 0};
+    while (sp > 0) {
+      const Iv iv = stack[--sp];
+      const double len = std::hypot(iv.b.x - iv.a.x, iv.b.y - iv.a.y);
+      if (iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
+          0.5 * len * std::tan(0.5 * (iv.pb - iv.pa)) <= 0.5 * tol) {
+        sc.pts.push_back(iv.a);
+        continue;
+      }
+      const double pm = 0.5 * (iv.pa + iv.pb);
+      double mlo = std::min(iv.ta_lo, iv.tb_lo), mhi = std::max(iv.ta_hi, iv.tb_hi);
+      const P2 m = hull.section_point(pm, zc, eps, mlo, mhi);
+      if (dist_to_line(m, iv.a, iv.b) <= eps) {
+        sc.pts.push_back(iv.a);
+        sc.pts.push_back(m);
+        continue;
+      }
+      stack[sp++] = {pm, iv.pb, m, iv.b, mlo, mhi, iv.tb_lo, iv.tb_hi, iv.depth + 1};  // right half last
+      stack[sp++] = {iv.pa, pm, iv.a, m, iv.ta_lo, iv.ta_hi, mlo, mhi, iv.depth + 1};
+    }
+  }
+}
+
+}  // namespace
+
 std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) const {
   const CutterShape& s = *shape_;
-  const double tol = s.chord_tol_mm;
   const int ns = static_cast<int>(s.stations.size());
   constexpr int kMaxStations = 512;
   Circle circles[2 * kMaxStations];
@@ -641,44 +707,7 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) co
       zhi = std::max(zhi, circles[i].c.z + e);
     }
     if (zc < zlo || zc > zhi) continue;
-    const Hull3 hull{&s, {pa, b}};
-    // Boundary points to 1/20 of the chord tolerance: the refinement below splits where a
-    // point lies farther than tol/2 from its chord.
-    constexpr double kPointEps = 0.05;
-    // Adaptive refinement in angle: start with 16 directions, split an interval while the
-    // boundary point at its middle lies farther than tol/2 from the chord.
-    sc.dirs.clear();
-    constexpr int kStart = 16;
-    constexpr int kMaxPoints = 8192;
-    for (int i = 0; i <= kStart; ++i) {
-      const double phi = 2.0 * std::numbers::pi * i / kStart;
-      sc.dirs.push_back({phi, i == kStart ? sc.dirs.front().p : hull.section_point(phi, zc, kPointEps * tol)});
-    }
-    sc.pts.clear();
-    // Depth-first refinement using `hull` storage as a stack of intervals (reused buffer).
-    for (int i = 0; i < kStart; ++i) {
-      struct Iv {
-        double pa, pb;
-        P2 a, b;
-        int depth;
-      };
-      Iv stack[64];
-      int sp = 0;
-      stack[sp++] = {sc.dirs[i].phi, sc.dirs[i + 1].phi, sc.dirs[i].p, sc.dirs[i + 1].p, 0};
-      while (sp > 0) {
-        const Iv iv = stack[--sp];
-        const double pm = 0.5 * (iv.pa + iv.pb);
-        const P2 m = hull.section_point(pm, zc, kPointEps * tol);
-        if (iv.depth < 40 && static_cast<int>(sc.pts.size()) < kMaxPoints && sp + 2 <= 64 &&
-            dist_to_line(m, iv.a, iv.b) > 0.5 * tol) {
-          stack[sp++] = {pm, iv.pb, m, iv.b, iv.depth + 1};  // right half processed last
-          stack[sp++] = {iv.pa, pm, iv.a, m, iv.depth + 1};
-        } else {
-          sc.pts.push_back(iv.a);
-          sc.pts.push_back(m);
-        }
-      }
-    }
+    refine_section(Hull3{&s, {pa, b}}, zc, s.chord_tol_mm, sc);
     convex_hull(sc.pts, sc.hull);
     emitted += emit(sc.hull, out, sc.spare);
   }

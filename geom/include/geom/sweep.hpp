@@ -51,6 +51,7 @@ struct SectionScratch {
   struct Dir {
     double phi;
     P2 p;
+    double t_lo, t_hi;  // the bracket of the 3D direction's tilt that found p (section_general)
   };
   std::vector<Dir> dirs;
   // Set by each vertical section: a capsule inside the polygon just emitted (invalid when
