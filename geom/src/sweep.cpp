@@ -134,8 +134,9 @@ struct Hull3 {
   // once a step moves the point by less than eps/2 (the steps left would move it by about
   // as much in all). The search starts from [t_lo, t_hi] (a neighbouring direction's
   // bracket: the tilt changes little between close directions), widened until it brackets
-  // the plane; `t_lo`/`t_hi` return the final bracket.
-  P2 section_point(double phi, double zc, double eps, double& t_lo, double& t_hi) const noexcept {
+  // the plane; `t_lo`/`t_hi` return the final bracket. At least `min_steps` + 1 steps: a
+  // wide start bracket can give a first step that happens to move little.
+  P2 section_point(double phi, double zc, double eps, double& t_lo, double& t_hi, int min_steps) const noexcept {
     const double ux = std::cos(phi), uy = std::sin(phi);
     auto sup = [&](double t) { return support(Vec3{ux, uy, t}); };
     double tlo = t_lo, thi = t_hi;
@@ -175,7 +176,7 @@ struct Hull3 {
       const P2 now = interpolate();
       const double dx = now.x - last.x, dy = now.y - last.y;
       last = now;
-      if (i >= 4 && dx * dx + dy * dy <= stop2) break;
+      if (i >= min_steps && dx * dx + dy * dy <= stop2) break;
     }
     t_lo = tlo;
     t_hi = thi;
@@ -639,6 +640,7 @@ void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc
   constexpr double kPointEps = 0.05;  // boundary points to tol/20
   constexpr int kStart = 16;
   constexpr int kMaxPoints = 8192;
+  constexpr int kWarmSteps = 1;  // a middle direction starts from its neighbours' brackets
   const double eps = kPointEps * tol;
   struct Iv {
     double pa, pb;
@@ -650,7 +652,7 @@ void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc
   double tlo = -1.0, thi = 1.0;
   for (int i = 0; i < kStart; ++i) {
     const double phi = 2.0 * std::numbers::pi * i / kStart;
-    const P2 p = hull.section_point(phi, zc, eps, tlo, thi);
+    const P2 p = hull.section_point(phi, zc, eps, tlo, thi, 4);
     sc.dirs.push_back({phi, p, tlo, thi});
   }
   sc.pts.clear();
@@ -670,7 +672,7 @@ void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc
       }
       const double pm = 0.5 * (iv.pa + iv.pb);
       double mlo = std::min(iv.ta_lo, iv.tb_lo), mhi = std::max(iv.ta_hi, iv.tb_hi);
-      const P2 m = hull.section_point(pm, zc, eps, mlo, mhi);
+      const P2 m = hull.section_point(pm, zc, eps, mlo, mhi, kWarmSteps);
       if (dist_to_line(m, iv.a, iv.b) <= eps) {
         sc.pts.push_back(iv.a);
         sc.pts.push_back(m);
