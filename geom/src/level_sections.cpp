@@ -44,7 +44,11 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
-  for (const auto& run : sh.runs) build_run_sections(zc, run, sh, ws, ls, stats);
+  // The material of this level before the batch (the cells' boxes): tilted sub-steps beside
+  // it are not built (Sweep::section()).
+  Rect material;
+  for (int r = 0; r < s_.regions(); ++r) material.add(s_.cell(r, level).bbox);
+  for (const auto& run : sh.runs) build_run_sections(zc, run, material, sh, ws, ls, stats);
   ls.chain.assign(ls.paths.size(), kNoChain);
   add_chain_sections(level, sh, ls);
   add_lathe_sections(zc, sh, ls);
@@ -108,8 +112,9 @@ void SubtractEngine::add_lathe_sections(double zc, const SubtractShared& sh, Lev
 // The sections of one run of sweeps on plane zc: consecutive moves whose sections share
 // their joint disk become one outline (chain_outline.hpp); the others are emitted one by
 // one, trimmed where the previous vertical section covers them (trim_covered()).
-void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
-                                  SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const {
+void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const Rect& material,
+                                        const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
+                                        SubtractStats& stats) const {
   Capsule prev_core;  // inside the last single vertical section of this run (trim_covered())
   auto push_boxes = [&](std::size_t before, MoveId id) {
     for (std::size_t k = before; k < ls.paths.size(); ++k) {
@@ -133,7 +138,7 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
     }
     if (!sw.vertical()) {
       const std::size_t before = ls.paths.size();
-      sw.section(zc, ls.paths, ws.scratch);
+      sw.section(zc, ls.paths, ws.scratch, &material);
       trim_tilted(si, before, sh, ws, ls, stats);
       if (ls.paths.size() > before) tilted_id = std::max(tilted_id, sh.sweep_id[si]);
       if (ls.paths.size() - ls.box.size() >= kTiltedGroup) flush_tilted();

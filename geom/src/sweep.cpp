@@ -238,10 +238,10 @@ Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcep
   }
 }
 
-std::size_t Sweep::section(double z_mm, Paths& out, SectionScratch& scratch) const {
+std::size_t Sweep::section(double z_mm, Paths& out, SectionScratch& scratch, const Rect* material) const {
   scratch.core = Capsule{};
   if (z_mm < box_.lo.z || z_mm > box_.hi.z) return 0;
-  return vertical_ ? section_vertical(z_mm, out, scratch) : section_general(z_mm, out, scratch);
+  return vertical_ ? section_vertical(z_mm, out, scratch) : section_general(z_mm, out, scratch, material);
 }
 
 bool Sweep::section_disks(double zc, SectionScratch& sc) const {
@@ -686,7 +686,39 @@ void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc
 
 }  // namespace
 
-std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) const {
+namespace {
+
+// True when the sub-step's hull (circles c[0..n)) certainly misses the material box `m`
+// [units] in XY: their boxes are apart, or the horizontal direction u from the box's
+// centre to the circles' centroid separates them (the hull's least u·p, one support query,
+// beyond the box's greatest). The section on any plane lies in the hull, so it would
+// remove nothing.
+bool beside_material(const Hull3& hull, const Circle* c, int n, const Rect& m) noexcept {
+  if (m.empty()) return true;
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY, cx = 0.0, cy = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double ex = c[i].r * std::sqrt(std::max(0.0, 1.0 - c[i].n.x * c[i].n.x));
+    const double ey = c[i].r * std::sqrt(std::max(0.0, 1.0 - c[i].n.y * c[i].n.y));
+    x0 = std::min(x0, c[i].c.x - ex);
+    x1 = std::max(x1, c[i].c.x + ex);
+    y0 = std::min(y0, c[i].c.y - ey);
+    y1 = std::max(y1, c[i].c.y + ey);
+    cx += c[i].c.x / n;
+    cy += c[i].c.y / n;
+  }
+  const double mx0 = to_mm(m.x0), mx1 = to_mm(m.x1), my0 = to_mm(m.y0), my1 = to_mm(m.y1);
+  if (x1 < mx0 || x0 > mx1 || y1 < my0 || y0 > my1) return true;
+  const double ux = cx - 0.5 * (mx0 + mx1), uy = cy - 0.5 * (my0 + my1), ul = std::hypot(ux, uy);
+  if (!(ul > 0.0)) return false;
+  const Vec3 u{ux / ul, uy / ul, 0.0};
+  const double hull_min = dot(hull.support(Vec3{-u.x, -u.y, 0.0}), u);
+  const double box_max = std::max(u.x * mx0, u.x * mx1) + std::max(u.y * my0, u.y * my1);
+  return hull_min > box_max;
+}
+
+}  // namespace
+
+std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc, const Rect* material) const {
   const CutterShape& s = *shape_;
   const int ns = static_cast<int>(s.stations.size());
   constexpr int kMaxStations = 512;
@@ -709,7 +741,9 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) co
       zhi = std::max(zhi, circles[i].c.z + e);
     }
     if (zc < zlo || zc > zhi) continue;
-    refine_section(Hull3{&s, {pa, b}}, zc, s.chord_tol_mm, sc);
+    const Hull3 hull{&s, {pa, b}};
+    if (material != nullptr && beside_material(hull, circles, nc, *material)) continue;
+    refine_section(hull, zc, s.chord_tol_mm, sc);
     convex_hull(sc.pts, sc.hull);
     emitted += emit(sc.hull, out, sc.spare);
   }
