@@ -95,28 +95,32 @@ int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
 // The convex hull of the tool's station circles at two poses (one sub-step of a move).
 // Its support in direction d is the larger of the two poses' supports, and at one pose the
 // support of station i is tip·d + h_i·(a·d) + r_i·|d⊥| (d⊥: d without its axis part). The
-// profile (h_i, r_i) is a concave chain, so that value is unimodal in i: a binary search on
-// its differences finds the best station in O(log stations) instead of a scan of all.
+// profile (h_i, r_i) is a concave chain, so the sign of its differences goes from + to
+// not +: the best station is the first whose step to the next does not increase the value.
+// Consecutive queries come from close directions, so it is found by walking from the last
+// query's station (one or two steps) rather than by a binary search; the result is the same.
 struct Hull3 {
   const CutterShape* shape;
   Pose pose[2];
+  mutable std::size_t last_station[2] = {0, 0};  // each pose's best station of the last query
   Vec3 support(const Vec3& d) const noexcept {
     const auto& st = shape->stations;
     double best = -INFINITY;
     Vec3 bp{};
-    for (const Pose& p : pose) {
+    const double dl = norm(d);
+    for (int k = 0; k < 2; ++k) {
+      const Pose& p = pose[k];
       const double along = dot(p.axis, d);
       const Vec3 perp = d - along * p.axis;
       const double pl = norm(perp);
-      const bool flat = pl <= 1e-15 * norm(d);
-      // First station whose step to the next does not increase the value.
-      std::size_t lo = 0, hi = st.size() - 1;
-      while (lo < hi) {
-        const std::size_t mid = (lo + hi) / 2;
-        const double step = (st[mid + 1].h - st[mid].h) * along + (flat ? 0.0 : (st[mid + 1].r - st[mid].r) * pl);
-        if (step > 0.0) lo = mid + 1;
-        else hi = mid;
-      }
+      const bool flat = pl <= 1e-15 * dl;
+      auto rises = [&](std::size_t i) {
+        return (st[i + 1].h - st[i].h) * along + (flat ? 0.0 : (st[i + 1].r - st[i].r) * pl) > 0.0;
+      };
+      std::size_t lo = last_station[k];
+      while (lo + 1 < st.size() && rises(lo)) ++lo;
+      while (lo > 0 && !rises(lo - 1)) --lo;
+      last_station[k] = lo;
       const double v = dot(p.tip, d) + st[lo].h * along + (flat ? 0.0 : st[lo].r * pl);
       if (v > best) {
         best = v;
