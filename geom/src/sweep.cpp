@@ -13,6 +13,7 @@
 #include "geom/sweep.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -652,6 +653,14 @@ void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc
     double ta_lo, ta_hi, tb_lo, tb_hi;
     int depth;
   };
+  // tan(Δφ/2) of an interval at each depth (Δφ = 2π/kStart/2^depth); beyond the table, the
+  // last entry bounds it.
+  constexpr int kDepths = 41;
+  static const std::array<double, kDepths> tan_half = [] {
+    std::array<double, kDepths> t{};
+    for (int d = 0; d < kDepths; ++d) t[static_cast<std::size_t>(d)] = std::tan(std::numbers::pi / kStart / std::ldexp(1.0, d));
+    return t;
+  }();
   sc.dirs.clear();
   double tlo = -1.0, thi = 1.0;
   for (int i = 0; i < kStart; ++i) {
@@ -668,9 +677,10 @@ void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc
                    sc.dirs[i].t_lo, sc.dirs[i].t_hi, sc.dirs[j].t_lo, sc.dirs[j].t_hi, 0};
     while (sp > 0) {
       const Iv iv = stack[--sp];
-      const double len = std::hypot(iv.b.x - iv.a.x, iv.b.y - iv.a.y);
+      const double dx = iv.b.x - iv.a.x, dy = iv.b.y - iv.a.y;
+      const double bound = 0.5 * tan_half[static_cast<std::size_t>(std::min(iv.depth, kDepths - 1))];  // |ab|/2 · tan(Δφ/2) / |ab|
       if (iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
-          0.5 * len * std::tan(0.5 * (iv.pb - iv.pa)) <= 0.5 * tol) {
+          bound * bound * (dx * dx + dy * dy) <= 0.25 * tol * tol) {
         sc.pts.push_back(iv.a);
         continue;
       }
