@@ -254,3 +254,65 @@ TEST(Joined, TiltedSweepBesideTheMaterialBuildsNoSection) {
   EXPECT_GT(test::removed(inside), 100.0);
   EXPECT_EQ(inside.check_invariants(), "");
 }
+
+// ---- geom::tight_loop_end(): where a batch ends so that one turn of a tight loop is cut at a time ----
+
+namespace {
+
+std::vector<geom::SweepRef> refs(const geom::CutterShape& c, const std::vector<geom::Vec3>& pts) {
+  std::vector<geom::SweepRef> out;
+  for (std::size_t i = 1; i < pts.size(); ++i)
+    out.push_back({&c, geom::Pose{pts[i - 1], {0, 0, 1}}, geom::Pose{pts[i], {0, 0, 1}}, static_cast<geom::MoveId>(i), nullptr});
+  return out;
+}
+
+}  // namespace
+
+TEST(TightLoop, HelixBatchEndsAfterOneTurn) {
+  // Flat Ø8 on a helix of radius 2 (4 mm across: within 2 diameters), 720 chords a turn: the
+  // turning between chords is 0.5°, a full circle after 720 of them, i.e. at move 721.
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 8), kTol);
+  const auto moves = refs(c, helix(30, 20, 2, 0, 1, 3, 720));
+  const std::size_t n = geom::tight_loop_end(moves);
+  EXPECT_NEAR(static_cast<double>(n), 721.0, 1.0);
+  // From there the next batch again holds one turn.
+  const std::size_t m = geom::tight_loop_end(std::span<const geom::SweepRef>(moves).subspan(n));
+  EXPECT_NEAR(static_cast<double>(m), 721.0, 1.0);
+}
+
+TEST(TightLoop, WideLoopsZigZagsAndToolChangesAreNotCut) {
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 8), kTol);
+  const auto d = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  // A circle of radius 20 (40 mm across: wider than 2 diameters of Ø8), three turns.
+  const auto wide = refs(c, helix(30, 20, 20, 0, 0.5, 2, 360));
+  EXPECT_EQ(geom::tight_loop_end(wide), wide.size());
+  // A zig-zag in a 1 mm square turns back and forth: no net turn.
+  std::vector<geom::Vec3> zz;
+  for (int i = 0; i < 400; ++i) zz.push_back({10.0 + (i % 2), 10.0 + 0.002 * i, -1.0});
+  const auto zig = refs(c, zz);
+  EXPECT_EQ(geom::tight_loop_end(zig), zig.size());
+  // Half a tight turn with one tool, then the other half with another: no loop of one tool.
+  auto mixed = refs(c, helix(30, 20, 2, 0, 0, 0, 720));
+  for (std::size_t i = 360; i < mixed.size(); ++i) mixed[i].shape = &d;
+  EXPECT_EQ(geom::tight_loop_end(mixed), mixed.size());
+}
+
+TEST(TightLoop, BatchesCutAtLoopsRemoveTheExactHelicalBore) {
+  // The bore of HelicalBoreIsTheAnnulusTimesTheDepth, in batches of at most 4096 moves each
+  // ended by tight_loop_end() (as lbrsim batch and the live geometry thread cut them).
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 8), kTol);
+  const auto moves = refs(c, helix(30, 20, 6, 0, 1, 5, 720));
+  std::size_t batches = 0;
+  for (std::size_t i = 0; i < moves.size(); ++batches) {
+    const auto part = std::span<const geom::SweepRef>(moves).subspan(i, std::min<std::size_t>(4096, moves.size() - i));
+    const std::size_t n = geom::tight_loop_end(part);
+    s.subtract(part.first(n));
+    i += n;
+  }
+  EXPECT_EQ(batches, 6u) << "one batch per turn";
+  const double exact = test::kPi * (100.0 - 4.0) * 5.0;
+  const double perimeter = 2.0 * test::kPi * (10.0 + 2.0);
+  EXPECT_NEAR(test::removed(s), exact, 2.0 * perimeter * kTol * 5.0);
+  EXPECT_EQ(s.check_invariants(), "");
+}

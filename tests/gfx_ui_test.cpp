@@ -10,12 +10,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <future>
 #include <functional>
 #include <memory>
 #include <thread>
 
 #include <glm/glm.hpp>
 
+#include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "app/view.hpp"
@@ -51,7 +53,8 @@ bool is_background(const std::uint8_t* p) {  // the clear colour (0.13, 0.14, 0.
 class UiWindow {
  public:
   UiWindow(const geom::LbrSolid& solid, gfx::StandardView view, gfx::ReplayControl* replay = nullptr, int width = kW,
-           int height = kH, bool kiosk = false, std::vector<std::string> program = {}) {
+           int height = kH, bool kiosk = false, std::vector<std::string> program = {}, std::string source = "gfx_ui_test",
+           gfx::SolidExchange* exchange = nullptr) {
     win_ = std::make_unique<gfx::Window>(width, height, true, "gfx_ui_test");
     gfx::RenderThreadConfig cfg;
     cfg.rate_hz = 20;
@@ -63,11 +66,11 @@ class UiWindow {
     cfg.render.show_tools = cfg.render.show_path = false;
     cfg.ui.enabled = true;
     cfg.ui.scale = 1.5f;
-    cfg.ui.source = "gfx_ui_test";
+    cfg.ui.source = std::move(source);
     cfg.ui.replay = replay;
     cfg.ui.kiosk = kiosk;
     cfg.ui.program = std::move(program);
-    rt_ = std::make_unique<gfx::RenderThread>(*win_, ex_, solid, cfg);
+    rt_ = std::make_unique<gfx::RenderThread>(*win_, exchange != nullptr ? *exchange : ex_, solid, cfg);
     router_ = std::make_unique<gfx::EventRouter>(*rt_, height);
     rt_->start();
   }
@@ -389,6 +392,103 @@ TEST_F(GfxUi, KioskQuitNeedsTheConfirmation) {
 
 // Not a check: with LBR_UI_SCREENSHOTS=DIR set, writes the pictures in docs/ui.md at the two
 // panel sizes (1024x768, 1280x800).
+// Taps at the window points where known points of the part project (top view): the panel
+// gets their coordinates (the pocket floor at z = -3, the top face at z = 0), the material
+// below them (7 and 10 mm) and their distance; a tap beside the part picks nothing.
+TEST_F(GfxUi, MeasureTapsReportThePointTheStockBelowAndTheDistance) {
+  UiWindow w(pocketed(), gfx::StandardView::Top);
+  w.tap("Measure");
+  ASSERT_TRUE(wait_for([&] { return w.rt().measuring(); }));
+  (void)w.item("Clear");  // the panel is up
+  const gfx::Camera cam = w.state().first;
+  auto tap_at = [&](glm::dvec3 p) {
+    const glm::dvec2 q = cam.project(p, kW, kH);
+    ASSERT_FALSE(w.rt().ui_hit(q.x, q.y)) << p.x << "," << p.y << " lies under the UI";
+    w.tap(q.x, q.y);
+  };
+  constexpr double kDeltaMm = 0.01;  // the tap lands where the point projects; the pick inverts it
+  tap_at({20, 15, 0});
+  ASSERT_TRUE(wait_for([&] { return w.rt().measured().size() == 1; }));
+  gfx::MeasurePoint a = w.rt().measured()[0];
+  EXPECT_NEAR(a.x_mm, 20, kDeltaMm);
+  EXPECT_NEAR(a.y_mm, 15, kDeltaMm);
+  EXPECT_NEAR(a.z_mm, kFloorZ, 1e-9);
+  EXPECT_TRUE(a.top_face);
+  EXPECT_NEAR(a.thickness_mm, 10 + kFloorZ, 1e-9);
+  EXPECT_NEAR(a.surface_z_mm, kFloorZ, 1e-9);
+  tap_at({25, 27, 0});
+  ASSERT_TRUE(wait_for([&] { return w.rt().measured().size() == 2; }));
+  const gfx::MeasurePoint b = w.rt().measured()[1];
+  EXPECT_NEAR(b.x_mm, 25, kDeltaMm);
+  EXPECT_NEAR(b.y_mm, 27, kDeltaMm);
+  EXPECT_NEAR(b.z_mm, 0, 1e-9);
+  EXPECT_NEAR(b.thickness_mm, 10, 1e-9);
+  const double d = std::sqrt((b.x_mm - a.x_mm) * (b.x_mm - a.x_mm) + (b.y_mm - a.y_mm) * (b.y_mm - a.y_mm) +
+                             (b.z_mm - a.z_mm) * (b.z_mm - a.z_mm));
+  EXPECT_NEAR(d, std::sqrt(5.0 * 5.0 + 12.0 * 12.0 + 3.0 * 3.0), 2 * kDeltaMm);
+  // Beside the part: a miss, the points stay.
+  tap_at({-1, 15, 0});
+  ASSERT_TRUE(wait_for([&] { return w.rt().measure_misses() == 1; }));
+  EXPECT_EQ(w.rt().measured().size(), 2U);
+  // A drag in Measure mode still orbits and picks nothing.
+  const double yaw = w.state().first.yaw;
+  w.drag(500, 300, 600, 300);
+  EXPECT_NE(w.state().first.yaw, yaw);
+  EXPECT_EQ(w.rt().measured().size(), 2U);
+  EXPECT_EQ(w.rt().measure_misses(), 1U);
+  // The switch turns the mode off again.
+  w.tap("Measure");
+  ASSERT_TRUE(wait_for([&] { return !w.rt().measuring(); }));
+}
+
+// `lbrsim run --source emulator:cam-pocket.ngc` as main.cpp runs it (the live pipeline on
+// its own thread, the window on this one), photographed half way.
+void run_screenshot(const std::string& png) {
+  const std::string cfg = std::string(LBR_SOURCE_DIR) + "/config/";
+  const app::Profile p = app::load_profile(cfg + "profiles/default-mill3.toml");
+  const std::string program = cfg + "programs/cam-pocket.ngc";
+  gfx::SolidExchange ex(1 << 14);
+  std::promise<geom::LbrSolid> initial;
+  std::atomic<bool> stop{false};
+  app::LiveOptions o;
+  o.source = "emulator:" + program;
+  o.speed = 25;  // 165 s of machining: a third to half way when the picture is taken
+  o.exchange = &ex;
+  o.on_start = [&](const geom::LbrSolid& s) { initial.set_value(s); };
+  std::thread live([&] { (void)app::run_live(p, o, stop); });
+  {
+    UiWindow w(initial.get_future().get(), gfx::StandardView::Iso, nullptr, kW, kH, false, app::program_text(program),
+               "emulator:config/programs/cam-pocket.ngc", &ex);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+    gfx::write_png(png, w.frame());
+    stop.store(true);
+  }
+  live.join();
+}
+
+// With a section on, the line of sight starts on the drawn side of the plane: a tap on the
+// cut face (iso view, X section at 20 mm) measures the cut face, not the part beyond it.
+TEST_F(GfxUi, MeasureOnASectionPicksTheCutFace) {
+  UiWindow w(pocketed(), gfx::StandardView::Iso);
+  w.tap("X");
+  ASSERT_TRUE(wait_for([&] { return w.state().second.section_axis == 0; }));
+  w.tap("Measure");
+  ASSERT_TRUE(wait_for([&] { return w.rt().measuring(); }));
+  (void)w.item("Clear");
+  const gfx::Camera cam = w.state().first;
+  const glm::dvec2 q = cam.project({20, 2, -5}, kW, kH);
+  ASSERT_FALSE(w.rt().ui_hit(q.x, q.y));
+  w.tap(q.x, q.y);
+  ASSERT_TRUE(wait_for([&] { return w.rt().measured().size() == 1; }));
+  const gfx::MeasurePoint p = w.rt().measured()[0];
+  EXPECT_NEAR(p.x_mm, 20, 1e-6);  // on the plane
+  EXPECT_NEAR(p.y_mm, 2, 0.01);
+  EXPECT_NEAR(p.z_mm, -5, 0.01);
+  EXPECT_FALSE(p.top_face);
+  EXPECT_NEAR(p.thickness_mm, p.z_mm + 10, 1e-9);
+  EXPECT_NEAR(p.surface_z_mm, 0, 1e-9);
+}
+
 TEST_F(GfxUi, Screenshots) {
   const char* dir = std::getenv("LBR_UI_SCREENSHOTS");
   if (dir == nullptr) GTEST_SKIP() << "set LBR_UI_SCREENSHOTS=DIR to write the docs' screenshots";
@@ -404,6 +504,19 @@ TEST_F(GfxUi, Screenshots) {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     gfx::write_png(std::string(dir) + "/ui-" + std::to_string(wpx) + "x" + std::to_string(hpx) + ".png", w.frame());
   }
+  {  // The Measure panel: two points on the iso view (pocket floor, top face).
+    UiWindow w(s, gfx::StandardView::Iso);
+    w.tap("Measure");
+    (void)w.item("Clear");
+    const gfx::Camera cam = w.state().first;
+    for (glm::dvec3 p : {glm::dvec3{20, 15, kFloorZ}, glm::dvec3{25, 27, 0}}) {
+      const glm::dvec2 q = cam.project(p, kW, kH);
+      w.tap(q.x, q.y);
+    }
+    (void)wait_for([&] { return w.rt().measured().size() == 2; });
+    gfx::write_png(std::string(dir) + "/ui-measure.png", w.frame());
+  }  // one UI at a time: ImGui's current context is process-wide
+  run_screenshot(std::string(dir) + "/ui-run.png");
 }
 
 }  // namespace

@@ -6,6 +6,9 @@ target_compile_definitions(app_view_stream_test PRIVATE LBR_SOURCE_DIR="${PROJEC
 # (white-box: the live pipeline's private headers in app/src/live/).
 lbr_test(app_live_alloc_test app_live_alloc_test.cpp alloc_counter.cpp)
 target_include_directories(app_live_alloc_test PRIVATE ${PROJECT_SOURCE_DIR}/app/src)
+# Live collision checks on the geometry thread (issue 16, white-box like the one above).
+lbr_test(app_live_checks_test app_live_checks_test.cpp alloc_counter.cpp)
+target_include_directories(app_live_checks_test PRIVATE ${PROJECT_SOURCE_DIR}/app/src)
 # Emulator blending against exact stop through the kernel (docs/nc-frontend.md#planner).
 lbr_test(app_emulator_blend_test app_emulator_blend_test.cpp)
 target_compile_definitions(app_emulator_blend_test PRIVATE LBR_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -4,6 +4,8 @@
 //   png_probe FILE hue                  prints how many pixels are strongly coloured orange (the
 //                                       tool's flute: R > G > B, R − B > 80)
 //   png_probe FILE diff OTHER           prints how many pixels differ by more than 24 in a channel
+//   png_probe FILE at X Y               prints the pixel at column X, row Y (negative: from the
+//                                       right / bottom edge) as "R G B"
 // Exit status 2 when the file cannot be read as a PNG.
 #include <cstdio>
 #include <cstdlib>
@@ -13,7 +15,7 @@
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: png_probe FILE [count R G B TOL | hue | diff OTHER]\n");
+    std::fprintf(stderr, "usage: png_probe FILE [count R G B TOL | hue | diff OTHER | at X Y]\n");
     return 2;
   }
   int w = 0, h = 0, n = 0;
@@ -23,6 +25,20 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string mode = argc > 2 ? argv[2] : "";
+  if (mode == "at" && argc == 5) {
+    int x = std::atoi(argv[3]), y = std::atoi(argv[4]);
+    if (x < 0) x += w;
+    if (y < 0) y += h;
+    if (x < 0 || x >= w || y < 0 || y >= h) {
+      std::fprintf(stderr, "png_probe: %s: pixel %s %s outside %dx%d\n", argv[1], argv[3], argv[4], w, h);
+      stbi_image_free(px);
+      return 2;
+    }
+    const unsigned char* p = px + 3 * (static_cast<long>(y) * w + x);
+    std::printf("%d %d %d\n", p[0], p[1], p[2]);
+    stbi_image_free(px);
+    return 0;
+  }
   unsigned char* other = nullptr;
   if (mode == "diff" && argc == 4) {
     int w2 = 0, h2 = 0, n2 = 0;

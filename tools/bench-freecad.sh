@@ -11,7 +11,7 @@
 # FreeCAD time: the PathSim.ApplyCommand loop only (like lbrsim's kernel time: no parsing, no
 # meshing), stock at RESOLUTION_MM (the GUI's 0.1 % accuracy on a 100 mm stock), tool profile
 # at 0.005 mm (the GUI's 0.05 x accuracy). lbrsim time: "simulated in" of lbrsim batch (kernel
-# wall time), Δ 0.1 mm, auto grid, one kernel thread. Removed volumes: FreeCAD from its result
+# wall time, collision checks off: FreeCAD has none), Δ 0.1 mm, auto grid, one kernel thread. Removed volumes: FreeCAD from its result
 # mesh, lbrsim from its summary line.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -142,7 +142,7 @@ for i in $(seq 1 "$REPEAT"); do
   fi
   read -r fc_t fc_moves fc_vol <"$TMP/fc.txt"
   rm -f "$TMP/fc.txt"
-  line=$("$LBRSIM" batch --quiet --threads 1 --program "$PROGRAM" --out "$TMP/lbr" | grep 'simulated in')
+  line=$("$LBRSIM" batch --quiet --no-checks --threads 1 --program "$PROGRAM" --out "$TMP/lbr" | grep 'simulated in')
   lbr_t=$(sed -E 's/.*simulated in ([0-9.]+) s.*/\1/' <<<"$line")
   lbr_vol=$(sed -E 's/^removed ([0-9.]+) mm3.*/\1/' <<<"$line")
   printf 'run %d: FreeCAD PathSimulator %.3f s (%d moves, removed %s mm3) | lbrsim %.3f s (removed %s mm3)\n' \

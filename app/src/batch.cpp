@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <stdexcept>
 
 namespace lbr::app {
@@ -51,16 +52,30 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   // while the current one is clipped).
   const std::size_t per = static_cast<std::size_t>(std::max(1, profile.batch_moves));
   std::size_t begin = 0;
+  std::deque<std::size_t> ends;  // where the batches pulled so far end
+  // A batch also ends where its path closes a tight loop (geom::tight_loop_end()).
+  auto cut_loops = [&](std::vector<geom::SweepRef>& out, std::size_t from) {
+    if (!std::is_sorted(moves.begin() + static_cast<long>(from), moves.begin() + static_cast<long>(from + out.size()),
+                        [](const motion::TimedSweep& a, const motion::TimedSweep& b) { return a.channel < b.channel; }))
+      return out.size();  // channels regrouped: several paths, no single loop to cut
+    out.resize(geom::tight_loop_end(out));
+    return out.size();
+  };
   const geom::ParallelSubtractor::BatchSource source = [&](std::vector<geom::SweepRef>& out) {
     if (begin >= moves.size()) return false;
-    const std::size_t end = std::min(begin + per, moves.size());
-    fill(begin, end, out);
-    begin = end;
+    fill(begin, std::min(begin + per, moves.size()), out);
+    begin += cut_loops(out, begin);
+    ends.push_back(begin);
     return true;
   };
   std::size_t done_moves = 0;
   const geom::ParallelSubtractor::BatchDone done = [&](const geom::SubtractStats&) {
-    done_moves = checker != nullptr ? begin : std::min(done_moves + per, moves.size());
+    if (checker != nullptr || ends.empty()) {
+      done_moves = begin;
+    } else {  // the pool may already have pulled the next batch
+      done_moves = ends.front();
+      ends.pop_front();
+    }
     if (!progress) return;
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(1)) {
@@ -76,7 +91,7 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
     while (begin < moves.size()) {
       const std::size_t end = checker->check(r.solid, moves, begin, std::min(begin + per, moves.size()), r.events);
       fill(begin, end, batch);
-      begin = end;
+      begin += cut_loops(batch, begin);
       const geom::SubtractStats s = pool.subtract(r.solid, batch);
       r.stats += s;
       done(s);
@@ -101,6 +116,7 @@ void compare_design(const Profile& profile, const std::vector<geom::Paths>& desi
   if (profile.design.stl_path.empty()) return;
   r.design = verify::compare_design(design, r.solid, profile.design.tolerance_mm);
   verify::attribute_gouge(*r.design, r.solid, moves, index);
+  r.design_sections = design;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
 #include "app/batch.hpp"
 #include "app/install_paths.hpp"
@@ -31,9 +32,17 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
     if (opt.on_warning) opt.on_warning(w);
     warnings.push_back(std::move(w));
   };
+  // Collision events go to the log as they are raised (docs/verification.md#live).
+  const auto log_events = [&pipeline] {
+    for (const auto& [error, line] : pipeline.new_events()) {
+      if (error) spdlog::error("{}", line);
+      else spdlog::warn("{}", line);
+    }
+  };
   while (pipeline.running()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     check_input();
+    log_events();
     if (status && sched::now_ns() >= next_status) {
       next_status += period;
       status(pipeline.status_line());
@@ -41,6 +50,7 @@ LiveResult run_live(const Profile& profile, const LiveOptions& opt, const std::a
   }
   pipeline.stop();
   check_input();
+  log_events();
   LiveResult r = pipeline.result();
   r.warnings = std::move(warnings);
   return r;
@@ -87,6 +97,16 @@ std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   j["resumed_generation"] = r.resumed_generation;
   j["resumed_position"] = r.resumed_position;
   j["peak_rss_mb"] = peak_rss_mb();
+  put_events_json(r.events, r.checks, j);
+  j["events_dropped"] = r.events_dropped;
+  j["rapid_threshold_mm_per_min"] = r.rapid_threshold_mm_per_min;
+  j["event_latency_count"] = r.event_latency_count;
+  j["event_latency_p50_ms"] = r.event_latency_p50_ms;
+  j["event_latency_p99_ms"] = r.event_latency_p99_ms;
+  j["event_latency_max_ms"] = r.event_latency_max_ms;
+  j["check_p50_ms"] = r.check_p50_ms;
+  j["check_p99_ms"] = r.check_p99_ms;
+  j["check_max_ms"] = r.check_max_ms;
   return j.dump(2) + "\n";
 }
 
@@ -96,6 +116,7 @@ void write_live_outputs(const std::string& dir, const LiveResult& r, const Profi
   if (ec) throw std::runtime_error(dir + ": cannot create output directory: " + ec.message());
   write_file((std::filesystem::path(dir) / "metrics.json").string(), live_metrics_json(r, profile));
   write_file((std::filesystem::path(dir) / "levels.lbrs").string(), geom::to_bytes(r.solid));
+  write_file((std::filesystem::path(dir) / "events.csv").string(), verify::events_csv(r.events));
 }
 
 nc::EmulatorLimits live_emulator_limits(const Profile& profile) {

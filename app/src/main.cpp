@@ -144,12 +144,17 @@ gfx::CaptureOptions capture_options(const BatchOptions& o) {
   return cap;
 }
 
-void write_png_if_asked(const geom::LbrSolid& solid, const BatchOptions& o, const gfx::CaptureOptions& cap,
+// --color deviation: colours from the design the run compared with (docs/verification.md#deviation-colour).
+bool deviation_colours(const BatchOptions& o) { return o.color == "deviation"; }
+
+void write_png_if_asked(const app::BatchResult& r, const BatchOptions& o, const gfx::CaptureOptions& cap,
                         const std::vector<gfx::ToolState>& tools) {
   if (o.png.empty()) return;
+  gfx::CaptureOptions c = cap;
+  if (deviation_colours(o)) c.deviation = app::deviation_fn(r.design_sections, r.solid, o.design_tolerance);
   // A picture of the finished part: the tool would hide part of it (issue 19), so it is
   // drawn only with --show-tool.
-  gfx::capture_png(solid, o.png, cap, o.show_tool && !o.no_tool ? tools : std::vector<gfx::ToolState>{});
+  gfx::capture_png(r.solid, o.png, c, o.show_tool && !o.no_tool ? tools : std::vector<gfx::ToolState>{});
   std::printf("wrote %s (%dx%d, view %s, colour %s)\n", o.png.c_str(), cap.width, cap.height, o.view.c_str(),
               o.color.c_str());
 }
@@ -195,7 +200,9 @@ void print_result(const app::BatchResult& r, const BatchOptions& o) {
               r.solid.regions_x(), r.solid.regions_y(), r.solid.vertex_count());
   std::printf("wrote %s, %s and %s\n", out_file(o.out, "metrics.json").c_str(), out_file(o.out, "levels.lbrs").c_str(),
               out_file(o.out, "events.csv").c_str());
-  app::write_mesh_files(r.solid, o.stl, o.ply);
+  app::DeviationColours colours;
+  if (deviation_colours(o)) colours = {&r.design_sections, o.design_tolerance};
+  app::write_mesh_files(r.solid, o.stl, o.ply, colours);
   if (!o.stl.empty()) std::printf("wrote %s\n", o.stl.c_str());
   if (!o.ply.empty()) std::printf("wrote %s\n", o.ply.c_str());
 }
@@ -219,7 +226,7 @@ int run_channels_command(const BatchOptions& o, const app::Profile& profile, con
   std::printf("%zu channels (%s)%s\n", channels.size(), names.c_str(), o.sampled ? ", sampled" : "");
   print_result(r, o);
   const int status = report_events(r, o);
-  write_png_if_asked(r.solid, o, cap, {});
+  write_png_if_asked(r, o, cap, {});
   return status;
 }
 
@@ -283,6 +290,8 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
 
 int run_batch_command(const BatchOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::warn);  // --quiet: the result lines and warnings only
+  if (deviation_colours(o) && o.design.empty())
+    throw std::runtime_error("--color deviation needs --design FILE.stl: the design model whose deviation it shows");
   const app::Profile profile = batch_profile(o);
   const gfx::CaptureOptions cap = capture_options(o);
   if (!profile.channels.empty()) return run_channels_command(o, profile, cap);
@@ -312,7 +321,7 @@ int run_batch_command(const BatchOptions& o) {
   app::write_batch_outputs(o.out, r, profile, program);
   print_result(r, o);
   const int status = report_events(r, o);
-  write_png_if_asked(r.solid, o, cap, app::final_tools(profile, path));
+  write_png_if_asked(r, o, cap, app::final_tools(profile, path));
   if (o.view_window) return run_view_command(o, ViewCliOptions{});
   return status;
 }
@@ -322,7 +331,7 @@ struct RunOptions {
   app::LiveOptions live;
   bool quiet = false;
   // rendering (gfx/): a viewer window when a display exists, screenshots on request
-  bool no_window = false, hidden = false, no_tool = false, no_ui = false;
+  bool no_window = false, hidden = false, no_tool = false, no_ui = false, kiosk = false;
   int screenshot_every = 0;
   std::string screenshot_prefix;  // empty: OUT/frame-
   std::string view = "iso", color = "heat", size = "1280x800";
@@ -391,6 +400,12 @@ gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profi
   rc.ui.enabled = !o.no_ui && !o.hidden && !o.no_window;
   rc.ui.scale = profile.render.ui.scale;
   rc.ui.source = o.live.source;
+  rc.ui.kiosk = o.kiosk;
+  // The program panel: the emulator's program file (the one that runs), else --program.
+  const bool emulator = o.live.source.rfind("emulator:", 0) == 0;
+  const std::string emu = emulator ? o.live.source.substr(9) : "";
+  if (emulator && emu != "demo") rc.ui.program = app::program_text(emu);
+  else if (!emulator && !o.live.program.empty()) rc.ui.program = app::program_text(o.live.program);
   return rc;
 }
 
@@ -460,7 +475,7 @@ class HudNotice {
 app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profile, const app::StatusFn& status) {
   const gfx::RenderThreadConfig rc = live_render_config(o, profile);
   const bool visible = !o.hidden && !o.no_window;
-  gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source);
+  gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source, o.kiosk);
   gfx::SolidExchange ex(1 << 14);
   std::promise<std::unique_ptr<geom::LbrSolid>> initial;
   auto initial_ready = initial.get_future();
@@ -498,7 +513,7 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
     set_render_thread(&rt);
     notice.attach(&rt);
     if (visible) {
-      gfx::run_event_loop(win, rt, [&] { return !live_done.load(); });
+      gfx::run_event_loop(win, rt, [&] { return !live_done.load(); }, o.kiosk);
       if (!live_done.load() && rt.running()) {  // the window was closed: end the run, keep its results
         g_window_closed.store(true);
         g_stop.store(true);
@@ -610,8 +625,10 @@ void add_render_options(CLI::App* c, BatchOptions& o) {
   c->add_option("--view", o.view, "Camera: top, front, side or iso")
       ->check(CLI::IsMember({"top", "front", "side", "iso"}))
       ->capture_default_str();
-  c->add_option("--color", o.color, "Colour mode: plain, heat (move of the last cut) or regions (grid)")
-      ->check(CLI::IsMember({"plain", "heat", "regions"}))
+  c->add_option("--color", o.color,
+                "Colour mode: plain, heat (move of the last cut), regions (grid) or deviation (from --design: "
+                "gouge red, excess blue)")
+      ->check(CLI::IsMember({"plain", "heat", "regions", "deviation"}))
       ->capture_default_str();
   c->add_option("--size", o.size, "Image / window size WxH [px]")->capture_default_str();
 }
@@ -701,6 +718,10 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_option("--source", ro.live.source,
                   "can:IFACE | serial:DEVICE | replay:LOGFILE | emulator:PROGRAM (PROGRAM 'demo' = bundled demo)")
       ->capture_default_str();
+  run->add_option("--program", ro.live.program,
+                  "The part program the machine runs (can, serial, replay sources): its current line is found from "
+                  "the sampled positions and its emulated time gives the progress")
+      ->check(CLI::ExistingFile);
   run->add_option("--stl", ro.stl, "Also write the final part as binary STL");
   run->add_option("--ply", ro.ply, "Also write the final part as binary PLY (with move ids)");
   run->add_option("--profile", ro.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
@@ -720,6 +741,7 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_flag("--no-window", ro.no_window, "Do not open the viewer even when a display exists");
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
   run->add_flag("--no-ui", ro.no_ui, "Hide the operator UI (status bar, view controls); the text HUD instead");
+  run->add_flag("--kiosk", ro.kiosk, "Full screen without decorations; quitting asks for a confirmation");
   run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "
                   "headless: xvfb-run -a)")->check(CLI::Range(0, 1000000));
   run->add_option("--screenshot-prefix", ro.screenshot_prefix,

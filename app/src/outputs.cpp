@@ -1,5 +1,6 @@
 #include "app/outputs.hpp"
 
+#include <array>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -123,6 +124,14 @@ nlohmann::json events_json(const std::vector<verify::Event>& events) {
 
 }  // namespace
 
+void put_events_json(const std::vector<verify::Event>& events, bool checks, nlohmann::json& j) {
+  j["checks"] = checks;
+  const verify::EventCounts counts = verify::count(events);
+  j["event_errors"] = counts.errors;
+  j["event_warnings"] = counts.warnings;
+  j["events"] = events_json(events);
+}
+
 std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program) {
   nlohmann::json j;
   j["lbrsim_version"] = version();
@@ -185,11 +194,30 @@ std::uint64_t write_samples_csv(const std::string& path, nc::Emulator& em) {
 void write_file(const std::string& path, const std::string& bytes) { write_bytes(path, bytes); }
 void write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) { write_bytes(path, bytes); }
 
-void write_mesh_files(const geom::LbrSolid& solid, const std::string& stl_path, const std::string& ply_path) {
+void write_mesh_files(const geom::LbrSolid& solid, const std::string& stl_path, const std::string& ply_path,
+                      const DeviationColours& colours) {
   if (stl_path.empty() && ply_path.empty()) return;
   const std::vector<mesh::MeshBuffers> regions = mesh::reconstruct(solid);
   if (!stl_path.empty()) write_file(stl_path, mesh::to_binary_stl(regions));
-  if (!ply_path.empty()) write_file(ply_path, mesh::to_binary_ply(regions));
+  if (ply_path.empty()) return;
+  std::vector<std::uint8_t> rgb;
+  if (colours.design != nullptr) {
+    std::vector<float> dev;
+    for (const mesh::MeshBuffers& m : regions) {
+      verify::vertex_deviation(*colours.design, solid, m.positions, m.normals, colours.tolerance_mm, dev);
+      for (float d : dev) {
+        const std::array<std::uint8_t, 3> c = gfx::deviation_rgb(d);
+        rgb.insert(rgb.end(), c.begin(), c.end());
+      }
+    }
+  }
+  write_file(ply_path, mesh::to_binary_ply(regions, rgb));
+}
+
+gfx::DeviationFn deviation_fn(const std::vector<geom::Paths>& design, const geom::LbrSolid& solid, double tolerance_mm) {
+  return [&design, &solid, tolerance_mm](const mesh::MeshBuffers& m, std::vector<float>& out) {
+    verify::vertex_deviation(design, solid, m.positions, m.normals, tolerance_mm, out);
+  };
 }
 
 void write_batch_outputs(const std::string& dir, const BatchResult& r, const Profile& profile,

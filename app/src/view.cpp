@@ -240,8 +240,8 @@ std::unique_ptr<geom::LbrSolid> publish_batch_result(const Profile& profile, con
   return solid;
 }
 
-// The program's lines for the UI's program panel; empty when the source is no readable file
-// (the built-in demo).
+}  // namespace
+
 std::vector<std::string> program_text(const std::string& file) {
   std::vector<std::string> lines;
   std::ifstream in(file);
@@ -251,8 +251,6 @@ std::vector<std::string> program_text(const std::string& file) {
   }
   return lines;
 }
-
-}  // namespace
 
 int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, const ViewOptions& opt) {
   gfx::RenderThreadConfig rc = opt.render;

@@ -3,12 +3,25 @@
 // turning sweeps, the levels they reach, and per level the chain offsets it needs.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "subtract_engine.hpp"
 
 namespace lbr::geom::detail {
 
 namespace {
+
+// An axis-aligned box in the XY plane [mm].
+struct Rect2 {
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  void add(double x, double y) noexcept {
+    x0 = std::min(x0, x);
+    y0 = std::min(y0, y);
+    x1 = std::max(x1, x);
+    y1 = std::max(y1, y);
+  }
+  [[nodiscard]] double span() const noexcept { return std::max(x1 - x0, y1 - y0); }
+};
 
 bool same_axis(const Vec3& a, const Vec3& b) noexcept { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
@@ -233,3 +246,39 @@ void SubtractEngine::size_storage(SubtractShared& sh) const {
 }
 
 }  // namespace lbr::geom::detail
+
+namespace lbr::geom {
+
+using detail::Rect2;
+
+std::size_t tight_loop_end(std::span<const SweepRef> moves) noexcept {
+  const CutterShape* tool = nullptr;
+  double turned = 0.0, dx = 0.0, dy = 0.0;
+  Rect2 box;
+  for (std::size_t i = 0; i < moves.size(); ++i) {
+    const SweepRef& m = moves[i];
+    const double mx = m.to.tip.x - m.from.tip.x, my = m.to.tip.y - m.from.tip.y;
+    if (m.shape == nullptr || m.shape != tool) {  // a turning move or another tool: start again
+      tool = m.shape;
+      turned = dx = dy = 0.0;
+      box = Rect2{};
+    }
+    if (tool == nullptr || (mx == 0.0 && my == 0.0)) continue;
+    box.add(m.from.tip.x, m.from.tip.y);
+    box.add(m.to.tip.x, m.to.tip.y);
+    if (box.span() > kTightLoopDiameters * 2.0 * tool->radius()) {  // a wide loop: count from here
+      turned = 0.0;
+      box = Rect2{};
+      box.add(m.from.tip.x, m.from.tip.y);
+      box.add(m.to.tip.x, m.to.tip.y);
+    } else if (dx != 0.0 || dy != 0.0) {
+      turned += std::atan2(dx * my - dy * mx, dx * mx + dy * my);  // signed: a zig-zag turns back
+      if (std::abs(turned) >= 2.0 * std::numbers::pi) return i + 1;
+    }
+    dx = mx;
+    dy = my;
+  }
+  return moves.size();
+}
+
+}  // namespace lbr::geom

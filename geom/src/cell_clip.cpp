@@ -16,20 +16,6 @@ constexpr std::size_t kCutSectionVertices = 16;
 // Margin of the box a clip path is cut to around the material it may touch [units].
 constexpr Coord kKeepMarginUnits = 16;
 
-// True when some edge of the closed contour has a box that meets b (conservative: the edge
-// may still miss b).
-bool edge_near(const Path& c, const Rect& b) noexcept {
-  for (std::size_t i = 0, j = c.size() - 1; i < c.size(); j = i++) {
-    const Point& p = c[i];
-    const Point& q = c[j];
-    if (std::max(p.X, q.X) < b.x0 || std::min(p.X, q.X) > b.x1 || std::max(p.Y, q.Y) < b.y0 || std::min(p.Y, q.Y) > b.y1)
-      continue;
-    return true;
-  }
-  return false;
-}
-
-
 // The sections whose box meets the cell's content (ws.selected) and the cell's polygons
 // whose box meets those sections (ws.touched); false when either is empty.
 bool select_for_cell(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws) {
@@ -48,30 +34,13 @@ bool select_for_cell(const Cell& cell, const LevelSections& ls, SubtractWorkspac
   return !ws.touched.empty();
 }
 
-// Sections in the air: when no edge of the material comes near a section's box, the box
-// lies wholly inside or wholly outside the material, and one point decides which. A
-// section outside removes nothing and leaves the clip (the shank of a finishing tool over
-// already cleared levels). False when none is left: nothing changes.
+// Sections in the air (cover_of() is None: no material in the section's box) leave the
+// clip: the shank of a finishing tool over already cleared levels. False when none is left:
+// nothing changes.
 bool drop_sections_in_air(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws, SubtractStats& stats) {
   std::size_t kept = 0;
   for (std::uint32_t k : ws.selected) {
-    const Rect& b = ls.box[k];
-    bool near = false, inside = false;
-    const Point centre{b.x0 + (b.x1 - b.x0) / 2, b.y0 + (b.y1 - b.y0) / 2};
-    for (std::uint32_t p : ws.touched) {
-      const Polygon& poly = cell.polys[p];
-      if (!poly.bbox.intersects(b)) continue;
-      near = edge_near(poly.outer.pts, b);
-      for (std::size_t h = 0; !near && h < poly.holes.size(); ++h) near = edge_near(poly.holes[h].pts, b);
-      if (near) break;
-      if (ClipperLib::PointInPolygon(centre, poly.outer.pts) != 0) {
-        inside = true;
-        for (const Contour& h : poly.holes)
-          if (ClipperLib::PointInPolygon(centre, h.pts) != 0) inside = false;
-        if (inside) break;
-      }
-    }
-    if (near || inside) ws.selected[kept++] = k;
+    if (cover_of(cell, ls.box[k]) != RectCover::None) ws.selected[kept++] = k;
     else ++stats.sections_in_air;
   }
   ws.selected.resize(kept);

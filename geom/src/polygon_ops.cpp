@@ -1,8 +1,26 @@
 #include "polygon_ops.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lbr::geom {
+
+namespace {
+
+// True when some edge of the closed contour has a box that meets b (conservative: the edge
+// may still miss b).
+bool edge_near(const Path& c, const Rect& b) noexcept {
+  for (std::size_t i = 0, j = c.size() - 1; i < c.size(); j = i++) {
+    const Point& p = c[i];
+    const Point& q = c[j];
+    if (std::max(p.X, q.X) < b.x0 || std::min(p.X, q.X) > b.x1 || std::max(p.Y, q.Y) < b.y0 || std::min(p.Y, q.Y) > b.y1)
+      continue;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
 
 double signed_area(const Path& p) noexcept { return ClipperLib::Area(p); }
 
@@ -11,6 +29,21 @@ void flatten(const Cell& cell, Paths& out) {
     out.push_back(poly.outer.pts);
     for (const Contour& h : poly.holes) out.push_back(h.pts);
   }
+}
+
+RectCover cover_of(const Cell& cell, const Rect& r) noexcept {
+  const Point centre{r.x0 + (r.x1 - r.x0) / 2, r.y0 + (r.y1 - r.y0) / 2};
+  bool inside = false;
+  for (const Polygon& poly : cell.polys) {
+    if (!poly.bbox.intersects(r)) continue;  // holes lie inside their outer contour
+    if (edge_near(poly.outer.pts, r)) return RectCover::Partly;
+    for (const Contour& h : poly.holes)
+      if (edge_near(h.pts, r)) return RectCover::Partly;
+    if (inside || ClipperLib::PointInPolygon(centre, poly.outer.pts) == 0) continue;
+    inside = std::none_of(poly.holes.begin(), poly.holes.end(),
+                          [&](const Contour& h) { return ClipperLib::PointInPolygon(centre, h.pts) != 0; });
+  }
+  return inside ? RectCover::All : RectCover::None;
 }
 
 namespace detail {

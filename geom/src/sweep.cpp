@@ -332,7 +332,7 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
     }
     return emit(sc.hull, out, sc.spare);
   }
-  ramp_hull(sc, n, grow, uc);
+  ramp_hull(sc, n, grow, uc, false);
   // Capsule: the disk farthest along the motion and the largest one (or the first).
   {
     const auto& ds = sc.disks;  // sorted by s, radii are circumradii now
@@ -347,43 +347,12 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
   return emit(sc.hull, out, sc.spare);
 }
 
-// Hull of several n-gons on one angle grid whose centres lie on the line of motion (a ramp),
-// without sorting points. Disk d has centre c0 + s_d·e (e: unit horizontal direction of the
-// motion) and circumradius ρ_d. For a direction θ = θ_k + δ with |δ| <= π/n the support
-// point of n-gon d is its vertex k, with value c_d·u(θ) + ρ_d·cos δ. Dividing by cos δ > 0,
-// the disk that wins is the one maximising the line L_d(h) = s_d·h + ρ_d at
-//   h = e·u(θ) / cos δ = cos φ - sin φ·tan δ,   φ = θ_k - θ_e,
-// which is monotone in δ. So: build the upper envelope of the lines once (slopes sorted),
-// then for each grid direction k walk the envelope from h(-π/n) to h(+π/n) and emit vertex k
-// of each winner. As θ grows the support point runs over the hull's vertices
-// counter-clockwise, so the output is the hull in order, in O(n + disks).
-void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<P2>& uc) const {
-  double ex = to_.tip.x - from_.tip.x, ey = to_.tip.y - from_.tip.y;
-  const double len = std::hypot(ex, ey);
-  if (len > 0.0) {
-    ex /= len;
-    ey /= len;
-  } else {
-    ex = 1.0;
-    ey = 0.0;
-  }
+namespace {
+
+// Upper envelope (max) of the lines L_d(h) = s_d·h + ρ_d of sc.disks (sorted by slope) over
+// all h, in sc.env; sc.breaks[i] is where env[i] overtakes env[i-1] (ramp_hull()).
+void upper_envelope(SectionScratch& sc) {
   auto& disks = sc.disks;
-  for (auto& d : disks) {
-    d.s = len > 0.0 ? (d.x - from_.tip.x) * ex + (d.y - from_.tip.y) * ey : 0.0;
-    d.r *= grow;  // from here on, r is the circumradius ρ
-  }
-  // Few disks (the tool's stations): insertion sort by slope, then by intercept.
-  for (std::size_t i = 1; i < disks.size(); ++i) {
-    const auto d = disks[i];
-    std::size_t j = i;
-    while (j > 0 && (disks[j - 1].s > d.s || (disks[j - 1].s == d.s && disks[j - 1].r > d.r))) {
-      disks[j] = disks[j - 1];
-      --j;
-    }
-    disks[j] = d;
-  }
-  // Upper envelope (max) of L_d(h) = s_d·h + ρ_d over all h; breaks[i] is where env[i]
-  // overtakes env[i-1].
   auto& env = sc.env;
   auto& br = sc.breaks;
   env.clear();
@@ -410,6 +379,48 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
       br.push_back(-INFINITY);
     }
   }
+}
+
+}  // namespace
+
+// Hull of several n-gons on one angle grid whose centres lie on the line of motion (a ramp),
+// without sorting points. Disk d has centre c0 + s_d·e (e: unit horizontal direction of the
+// motion) and circumradius ρ_d. For a direction θ = θ_k + δ with |δ| <= π/n the support
+// point of n-gon d is its vertex k, with value c_d·u(θ) + ρ_d·cos δ. Dividing by cos δ > 0,
+// the disk that wins is the one maximising the line L_d(h) = s_d·h + ρ_d at
+//   h = e·u(θ) / cos δ = cos φ - sin φ·tan δ,   φ = θ_k - θ_e,
+// which is monotone in δ. So: build the upper envelope of the lines once (slopes sorted),
+// then for each grid direction k walk the envelope from h(-π/n) to h(+π/n) and emit vertex k
+// of each winner. As θ grows the support point runs over the hull's vertices
+// counter-clockwise, so the output is the hull in order, in O(n + disks).
+void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<P2>& uc, bool ends_only) const {
+  double ex = to_.tip.x - from_.tip.x, ey = to_.tip.y - from_.tip.y;
+  const double len = std::hypot(ex, ey);
+  if (len > 0.0) {
+    ex /= len;
+    ey /= len;
+  } else {
+    ex = 1.0;
+    ey = 0.0;
+  }
+  auto& disks = sc.disks;
+  for (auto& d : disks) {
+    d.s = len > 0.0 ? (d.x - from_.tip.x) * ex + (d.y - from_.tip.y) * ey : 0.0;
+    d.r *= grow;  // from here on, r is the circumradius ρ
+  }
+  // Few disks (the tool's stations): insertion sort by slope, then by intercept.
+  for (std::size_t i = 1; i < disks.size(); ++i) {
+    const auto d = disks[i];
+    std::size_t j = i;
+    while (j > 0 && (disks[j - 1].s > d.s || (disks[j - 1].s == d.s && disks[j - 1].r > d.r))) {
+      disks[j] = disks[j - 1];
+      --j;
+    }
+    disks[j] = d;
+  }
+  upper_envelope(sc);
+  const auto& env = sc.env;
+  const auto& br = sc.breaks;
   const int m = static_cast<int>(env.size());
   // Index of the envelope piece that wins at h.
   auto piece = [&](double h) {
@@ -425,6 +436,7 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
   sc.hull.clear();
   sc.hull_role.clear();
   sc.hull_grid.clear();
+  int run_piece = -1, run_len = 0;
   for (int k = 0; k < n; ++k) {
     const double ck = uc[k].x, sk = uc[k].y;
     const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
@@ -440,6 +452,17 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
       i0 = piece(hp);
       i1 = piece(hm);
     }
+    // ends_only: a run of directions that one end disk wins whole keeps its first and last
+    // vertex (the caps' grid interval is all section_caps() needs of it).
+    const bool whole = i0 == i1 && disks[env[i0]].role != 0;
+    if (ends_only && whole && i0 == run_piece && run_len >= 2) {
+      const auto& d = disks[env[i0]];
+      sc.hull.back() = {d.x + d.r * ck, d.y + d.r * sk};
+      sc.hull_grid.back() = k;
+      continue;
+    }
+    run_len = !whole ? 0 : i0 == run_piece ? run_len + 1 : 1;
+    run_piece = whole ? i0 : -1;
     const int step = i1 >= i0 ? 1 : -1;
     for (int i = i0;; i += step) {
       const auto& d = disks[env[i]];
@@ -479,7 +502,7 @@ bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) co
     out.front_l = out.back_l = nearest(th + 0.5 * std::numbers::pi);
     return true;
   }
-  ramp_hull(sc, n, grow, sc.unit_circle(n));
+  ramp_hull(sc, n, grow, sc.unit_circle(n), true);
   // The caps are the hull's runs of start-disk and end-disk vertices; each must be one run.
   const std::size_t m = sc.hull.size();
   // One pass: where each role's run starts and ends (a role with two runs, or none, fails).

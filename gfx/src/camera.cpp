@@ -102,6 +102,14 @@ glm::dvec2 Camera::project(const glm::dvec3& p, int w, int h) const noexcept {
   return {(ndc.x * 0.5 + 0.5) * w, (0.5 - ndc.y * 0.5) * h};
 }
 
+void Camera::ray(double x, double y, int w, int h, glm::dvec3& origin, glm::dvec3& dir) const noexcept {
+  const glm::dmat4 inv = glm::inverse(projection(static_cast<double>(w) / h) * view());
+  const double nx = 2.0 * x / w - 1.0, ny = 1.0 - 2.0 * y / h;
+  const glm::dvec4 a = inv * glm::dvec4(nx, ny, -1.0, 1.0), b = inv * glm::dvec4(nx, ny, 1.0, 1.0);
+  origin = glm::dvec3(a) / a.w;
+  dir = glm::dvec3(b) / b.w - origin;
+}
+
 Frustum::Frustum(const glm::dmat4& m) noexcept {
   // Rows of the (column-major) matrix.
   auto row = [&](int i) { return glm::dvec4(m[0][i], m[1][i], m[2][i], m[3][i]); };

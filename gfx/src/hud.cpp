@@ -68,7 +68,26 @@ Hud::~Hud() {
   glDeleteProgram(prog_);
 }
 
-void Hud::draw(const std::string& text, int w, int h, float scale) {
+void Hud::draw(const std::string& text, int w, int h, float scale) { draw_panel(text, w, h, scale, Panel{}); }
+
+void Hud::draw_alarm_band(const std::string& text, int w, int h, float scale) {
+  if (text.empty() || w <= 0 || h <= 0) return;
+  std::size_t lines = 1, longest = 0, cur = 0;
+  for (char ch : text) {
+    if (ch == '\n') { ++lines; longest = std::max(longest, cur); cur = 0; } else { ++cur; }
+  }
+  longest = std::max(longest, cur);
+  const float pw = 6.0f * static_cast<float>(longest) + 8.0f, ph = 12.0f * static_cast<float>(lines) + 4.0f;
+  scale = std::clamp(static_cast<float>(w) / pw, 1.0f, scale);  // as draw_panel() will
+  Panel band;
+  band.y = static_cast<float>(h) / scale - ph;
+  band.min_width = static_cast<float>(w) / scale;
+  const std::uint8_t red[4] = {140, 15, 13, 255};  // the status bar's alarm colour (ui.cpp), opaque
+  std::copy_n(red, 4, band.bg);
+  draw_panel(text, w, h, scale, band);
+}
+
+void Hud::draw_panel(const std::string& text, int w, int h, float scale, const Panel& panel) {
   if (text.empty() || w <= 0 || h <= 0) return;
   // Panel first (one quad), then the glyph quads.
   std::vector<FontVertex> verts;
@@ -77,17 +96,17 @@ void Hud::draw(const std::string& text, int w, int h, float scale) {
     if (ch == '\n') { ++lines; longest = std::max(longest, cur); cur = 0; } else { ++cur; }
   }
   longest = std::max(longest, cur);
-  const float pw = 6.0f * static_cast<float>(longest) + 8.0f, ph = 12.0f * static_cast<float>(lines) + 4.0f;
-  scale = std::clamp(static_cast<float>(w) / pw, 1.0f, scale);  // fit narrow viewports
-  const std::uint8_t bg[4] = {10, 12, 16, 170};
-  for (auto [x, y] : {std::pair{0.0f, 0.0f}, {pw, 0.0f}, {pw, ph}, {0.0f, ph}}) {
-    FontVertex v{x, y, 0, {bg[0], bg[1], bg[2], bg[3]}};
+  const float tw = 6.0f * static_cast<float>(longest) + 8.0f, ph = 12.0f * static_cast<float>(lines) + 4.0f;
+  scale = std::clamp(static_cast<float>(w) / tw, 1.0f, scale);  // fit narrow viewports
+  const float pw = std::max(tw, panel.min_width), x0 = panel.x, y0 = panel.y;
+  for (auto [x, y] : {std::pair{x0, y0}, {x0 + pw, y0}, {x0 + pw, y0 + ph}, {x0, y0 + ph}}) {
+    FontVertex v{x, y, 0, {panel.bg[0], panel.bg[1], panel.bg[2], panel.bg[3]}};
     verts.push_back(v);
   }
   buf_.resize(text.size() * 270 + 1024);
   std::string copy = text;
   unsigned char col[4] = {235, 240, 245, 255};
-  const int quads = stb_easy_font_print(4.0f, 4.0f, copy.data(), col, buf_.data(), static_cast<int>(buf_.size()));
+  const int quads = stb_easy_font_print(x0 + 4.0f, y0 + 4.0f, copy.data(), col, buf_.data(), static_cast<int>(buf_.size()));
   const auto* fv = reinterpret_cast<const FontVertex*>(buf_.data());
   verts.insert(verts.end(), fv, fv + 4 * quads);
   const std::size_t nq = verts.size() / 4;

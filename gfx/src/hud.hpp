@@ -2,6 +2,7 @@
 // (Debian libstb-dev) over a translucent panel, in window pixels.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -17,8 +18,17 @@ class Hud {
   Hud& operator=(const Hud&) = delete;
   // Draws `text` (lines separated by '\n') at the top-left of a w × h viewport.
   void draw(const std::string& text, int w, int h, float scale = 2.0f);
+  // Draws `text` on an opaque red band across the bottom of the viewport (alarms).
+  void draw_alarm_band(const std::string& text, int w, int h, float scale = 2.0f);
 
  private:
+  struct Panel {
+    float x = 0, y = 0;          // top-left of the panel [font units]
+    float min_width = 0;         // at least this wide [font units]
+    std::uint8_t bg[4] = {10, 12, 16, 170};
+  };
+  void draw_panel(const std::string& text, int w, int h, float scale, const Panel& panel);
+
   GLuint prog_ = 0, vao_ = 0, vbo_ = 0, ebo_ = 0;
   GLint u_screen_ = -1;
   std::vector<char> buf_;

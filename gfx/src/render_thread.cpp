@@ -1,5 +1,6 @@
 #include "gfx/render_thread.hpp"
 
+#include "measure.hpp"
 #include "ui.hpp"
 
 #include <algorithm>
@@ -87,6 +88,22 @@ bool RenderThread::ui_item(const std::string& label, UiRect& out) {
   return false;
 }
 
+void RenderThread::pick(double x, double y) {
+  if (!ui_on_) return;
+  std::lock_guard lock(mu_);
+  if (picks_.size() < 8) picks_.emplace_back(x, y);
+}
+
+std::vector<MeasurePoint> RenderThread::measured() {
+  std::lock_guard lock(mu_);
+  return measured_;
+}
+
+std::uint64_t RenderThread::measure_misses() {
+  std::lock_guard lock(mu_);
+  return measure_misses_;
+}
+
 void RenderThread::ask_quit() {
   std::lock_guard lock(mu_);
   ask_quit_ = true;
@@ -128,7 +145,9 @@ void RenderThread::sync(Renderer& ren, Camera& cam, int& w, int& h) {
 void RenderThread::apply_ui(const detail::UiActions& act) {
   if (act.quit) quit_.store(true, std::memory_order_release);
   if (act.touch_pan >= 0) touch_pan_.store(act.touch_pan == 1, std::memory_order_relaxed);
+  if (act.measure >= 0) measuring_.store(act.measure == 1, std::memory_order_relaxed);
   std::lock_guard lock(mu_);
+  measured_ = ui_->measured();
   ask_quit_ = false;
   ui_rects_ = ui_->rects();
   ui_items_.clear();
@@ -176,7 +195,8 @@ FrameInfo RenderThread::draw(Renderer& ren, const Camera& cam, int w, int h, dou
         std::lock_guard lock(mu_);
         ask = ask_quit_;
       }
-      const detail::UiFrameInput in{cam, ren.options(), touch_pan(), ask, w, h, dt_s};
+      serve_picks(ren, cam, w, h);
+      const detail::UiFrameInput in{cam, ren.options(), touch_pan(), measuring(), ask, w, h, dt_s};
       apply_ui(ui_->frame(ren, in));
     }
     serve_capture(w, h);
@@ -185,6 +205,26 @@ FrameInfo RenderThread::draw(Renderer& ren, const Camera& cam, int w, int h, dou
     glFinish();  // the frame's work is done (and measured) within its own period
   }
   return fi;
+}
+
+// Taps of the Measure tool, against the mirror solid as this frame shows it (the levels of
+// the regions drawn; never the geometry thread's solid).
+void RenderThread::serve_picks(Renderer& ren, const Camera& cam, int w, int h) {
+  std::vector<std::pair<double, double>> picks;
+  {
+    std::lock_guard lock(mu_);
+    picks.swap(picks_);
+  }
+  for (const auto& [x, y] : picks) {
+    MeasurePoint p;
+    if (detail::measure_at(ren.mirror().solid(), cam, ren.options(), x, y, w, h, p)) {
+      ui_->add_measure(p);
+    } else {
+      ui_->measure_missed();
+      std::lock_guard lock(mu_);
+      ++measure_misses_;
+    }
+  }
 }
 
 // A capture() waiting on the main thread gets this frame's back buffer.

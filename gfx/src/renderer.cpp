@@ -84,7 +84,8 @@ void main() {
 })";
 
 // Modes: 0 plain, 1 heat (by move id of the last cut), 2 region colour, 3 constant colour
-// (tools), 4 unlit constant colour (path).
+// (tools), 4 unlit constant colour (path), 5 deviation (v_attr: signed deviation from the
+// design model [mm], gfx::deviation_rgb()).
 const char* kMeshFs = R"(#version 330 core
 in vec3 v_pos;
 in vec3 v_nrm;
@@ -135,6 +136,8 @@ void main() {
   vec3 base = u_color;
   if (u_mode == 1) {
     base = (v_attr < 0.5 || on_stock_face(v_pos)) ? vec3(0.60, 0.61, 0.63) : heat(v_attr / max(u_max_attr, 1.0));
+  } else if (u_mode == 5) {
+    base = v_attr < 0.0 ? vec3(0.86, 0.12, 0.10) : (v_attr > 0.0 ? vec3(0.15, 0.35, 0.90) : vec3(0.55, 0.66, 0.55));
   }
   vec3 L = normalize(u_key);
   vec3 F = normalize(vec3(-u_key.x, -u_key.y, 0.35));  // fill from the opposite side
@@ -178,7 +181,15 @@ ColorMode parse_color_mode(const std::string& s) {
   if (s == "plain") return ColorMode::Plain;
   if (s == "heat") return ColorMode::Heat;
   if (s == "regions") return ColorMode::Regions;
-  throw std::invalid_argument("unknown colour mode '" + s + "' (expected plain, heat or regions)");
+  if (s == "deviation") return ColorMode::Deviation;
+  throw std::invalid_argument("unknown colour mode '" + s + "' (expected plain, heat, regions or deviation)");
+}
+
+std::array<std::uint8_t, 3> deviation_rgb(float d_mm) noexcept {
+  // As kMeshFs's deviation(): gouge (0.86, 0.12, 0.10), excess (0.15, 0.35, 0.90), within (0.55, 0.66, 0.55).
+  if (d_mm < 0.0f) return {219, 31, 26};
+  if (d_mm > 0.0f) return {38, 89, 230};
+  return {140, 168, 140};
 }
 
 const char* to_string(ColorMode m) noexcept {
@@ -186,6 +197,7 @@ const char* to_string(ColorMode m) noexcept {
     case ColorMode::Plain: return "plain";
     case ColorMode::Heat: return "heat";
     case ColorMode::Regions: return "regions";
+    case ColorMode::Deviation: return "deviation";
   }
   return "?";
 }
@@ -196,6 +208,7 @@ struct Renderer::Gl {
     GLsizei count = 0;
     std::uint64_t generation = ~std::uint64_t{0};
     std::uint64_t uploads = 0;
+    bool deviation = false;  // the attribute buffer holds deviations, not move ids
   };
   GLuint prog = 0;
   GLint u_vp = -1, u_model = -1, u_mode = -1, u_color = -1, u_max_attr = -1, u_eye = -1, u_key = -1, u_lo = -1,
@@ -431,7 +444,8 @@ void Renderer::upload_changed(FrameInfo& fi) {
   for (int r = 0; r < mirror_.regions(); ++r) {
     Gl::Region& gr = gl_->regions[static_cast<std::size_t>(r)];
     const mesh::MeshBuffers& mb = mirror_.meshes().region(r);
-    if (gr.generation == mb.generation) continue;
+    const bool deviation = opt_.color == ColorMode::Deviation && opt_.deviation;
+    if (gr.generation == mb.generation && gr.deviation == deviation) continue;
     // Joined walls keep zero-area triangles for the mesh's edge identities (docs/mesh.md
     // §2); they draw nothing, so they are left out of the GPU index buffer.
     upload_idx_.clear();
@@ -445,7 +459,9 @@ void Renderer::upload_changed(FrameInfo& fi) {
       if (glm::dot(n, n) <= 1e-14f) continue;  // area below 5e-8 mm²
       upload_idx_.insert(upload_idx_.end(), {a, b, c});
     }
-    Gl::upload(gr.vao, gr.vbo, gr.ebo, mb.positions, mb.normals, mb.attributes, upload_idx_);
+    if (deviation) opt_.deviation(mb, deviation_);
+    Gl::upload(gr.vao, gr.vbo, gr.ebo, mb.positions, mb.normals, deviation ? deviation_ : mb.attributes, upload_idx_);
+    gr.deviation = deviation;
     gr.count = static_cast<GLsizei>(upload_idx_.size());
     gr.generation = mb.generation;
     ++gr.uploads;
@@ -480,7 +496,8 @@ void Renderer::draw_stock(const Camera& cam, const glm::dmat4& vp, int w, int h,
   glUseProgram(g.prog);
   set_scene_uniforms(cam, vp);
   set_section();
-  const int mode = opt_.color == ColorMode::Plain ? 0 : (opt_.color == ColorMode::Heat ? 1 : 2);
+  int mode = opt_.color == ColorMode::Plain ? 0 : (opt_.color == ColorMode::Heat ? 1 : 2);
+  if (opt_.color == ColorMode::Deviation) mode = opt_.deviation ? 5 : 0;
   glUniform1i(g.u_mode, mode);
   glUniform3f(g.u_color, 0.66f, 0.68f, 0.71f);
   for (int r = 0; r < mirror_.regions(); ++r) {
@@ -644,6 +661,26 @@ void Renderer::draw_hud(int w, int h) {
     std::snprintf(buf + used, sizeof buf - used, "WARNING: %s\n", opt_.notice.c_str());
   }
   gl_->hud->draw(buf, w, h);
+  draw_alarms(w, h);
+}
+
+// The live alarms (collision events) on a red band across the bottom, as the operator UI's
+// status bar shows them (docs/ui.md).
+void Renderer::draw_alarms(int w, int h) {
+  const LiveStats& L = live_;
+  const int n = std::min(L.alarm_count, kMaxAlarms);
+  if (n <= 0) return;
+  char buf[kMaxAlarms * (kAlarmTextChars + 16)];
+  std::size_t used = 0;
+  buf[0] = '\0';
+  for (int i = 0; i < n; ++i) {
+    const Alarm& a = L.alarms[static_cast<std::size_t>(i)];
+    const char* tag = a.severity == AlarmSeverity::Error ? "ALARM" : (a.severity == AlarmSeverity::Warning ? "WARNING" : "INFO");
+    const int k = std::snprintf(buf + used, sizeof buf - used, "%s%s: %s", i > 0 ? "\n" : "", tag, a.text.data());
+    if (k < 0 || static_cast<std::size_t>(k) >= sizeof buf - used) break;
+    used += static_cast<std::size_t>(k);
+  }
+  gl_->hud->draw_alarm_band(buf, w, h);
 }
 
 FrameInfo Renderer::frame_offscreen(const Camera& cam, int w, int h) {

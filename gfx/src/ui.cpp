@@ -99,7 +99,9 @@ UiActions Ui::frame(const Renderer& ren, const UiFrameInput& in) {
   view_panel(in, act);
   replay_h_ = 0;
   if (cfg_.replay != nullptr) replay_bar(ren);
+  program_bottom_ = replay_h_;
   if (!cfg_.program.empty()) program_panel(ren, in);
+  if (in.measuring) measure_panel(in);
   quit_dialog(in, act);
   ImGui::Render();
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -271,6 +273,7 @@ void Ui::view_panel(const UiFrameInput& in, UiActions& act) {
     if (toggle_button("Orbit", !in.touch_pan, b)) act.touch_pan = 0;
     ImGui::SameLine();
     if (toggle_button("Pan", in.touch_pan, b)) act.touch_pan = 1;
+    if (toggle_button("Measure", in.measuring, ImVec2(-1, b.y))) act.measure = in.measuring ? 0 : 1;
     ImGui::Separator();
     section_controls(act);
     if (cfg_.kiosk) {
@@ -424,8 +427,62 @@ void Ui::program_panel(const Renderer& ren, const UiFrameInput& in) {
       }
     }
     remember_window();
+    program_bottom_ = ImGui::GetWindowPos().y + ImGui::GetWindowSize().y;
   }
   ImGui::End();
+}
+
+// ---- measure panel (left, above the status bar) ----------------------------------------
+
+void Ui::add_measure(const MeasurePoint& p) {
+  if (measured_.size() >= 2) measured_.clear();
+  measured_.push_back(p);
+  measure_miss_ = false;
+}
+
+void Ui::measure_panel(const UiFrameInput& in) {
+  const float fs = ImGui::GetFontSize();
+  ImGui::SetNextWindowPos(ImVec2(0, static_cast<float>(in.height) - status_h_), ImGuiCond_Always, ImVec2(0, 1));
+  const float max_h = std::max(fs * 4, static_cast<float>(in.height) - status_h_ - program_bottom_);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(fs * 25, 0), ImVec2(fs * 25, max_h));
+  if (ImGui::Begin("##measure", nullptr, kFixed | ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::TextUnformatted(measured_.size() == 1 ? "Measure: tap a second point" : "Measure: tap a point of the part");
+    if (measure_miss_) ImGui::TextColored(kAmber, "no material under the last tap");
+    for (std::size_t i = 0; i < measured_.size(); ++i) {
+      const MeasurePoint& p = measured_[i];
+      ImGui::Text("P%zu  X %.3f  Y %.3f  Z %.3f", i + 1, p.x_mm, p.y_mm, p.z_mm);
+      ImGui::TextColored(kGrey, "    stock below %.3f mm, top Z %.3f", p.thickness_mm, p.surface_z_mm);
+    }
+    if (measured_.size() == 2) {
+      const MeasurePoint &a = measured_[0], &b = measured_[1];
+      const double dx = b.x_mm - a.x_mm, dy = b.y_mm - a.y_mm, dz = b.z_mm - a.z_mm;
+      ImGui::Text("distance %.3f mm", std::sqrt(dx * dx + dy * dy + dz * dz));
+      ImGui::TextColored(kGrey, "    dX %.3f  dY %.3f  dZ %.3f", dx, dy, dz);
+    }
+    if (button("Clear", ImVec2(fs * 6, ImGui::GetFrameHeight() * 1.3f))) {
+      measured_.clear();
+      measure_miss_ = false;
+    }
+    remember_window();
+  }
+  ImGui::End();
+  mark_points(in);
+}
+
+// The picked points (and the line between them) over the 3D view.
+void Ui::mark_points(const UiFrameInput& in) {
+  ImDrawList* dl = ImGui::GetForegroundDrawList();
+  const float r = ImGui::GetFontSize() * 0.3f;
+  ImVec2 prev;
+  for (std::size_t i = 0; i < measured_.size(); ++i) {
+    const MeasurePoint& p = measured_[i];
+    const glm::dvec2 q = in.cam.project({p.x_mm, p.y_mm, p.z_mm}, in.width, in.height);
+    const ImVec2 at(static_cast<float>(q.x), static_cast<float>(q.y));
+    if (i > 0) dl->AddLine(prev, at, ImGui::GetColorU32(kAmber), 2.0f);
+    dl->AddCircleFilled(at, r, ImGui::GetColorU32(kAmber));
+    dl->AddText(ImVec2(at.x + r, at.y - 2 * r - ImGui::GetFontSize() * 0.5f), ImGui::GetColorU32(kAmber), i == 0 ? "P1" : "P2");
+    prev = at;
+  }
 }
 
 // ---- quit confirmation (kiosk) ---------------------------------------------------------

@@ -32,6 +32,7 @@ struct UiActions {
   bool options_changed = false;
   RenderOptions opt;           // color, show_tools, show_path, show_outline, section_*
   int touch_pan = -1;          // one-finger drag: 0 orbit, 1 pan, -1 unchanged
+  int measure = -1;            // Measure mode: 0 off, 1 on, -1 unchanged
   bool quit = false;           // confirmed quit (kiosk)
 };
 
@@ -40,6 +41,7 @@ struct UiFrameInput {
   const Camera& cam;
   const RenderOptions& opt;
   bool touch_pan = false;
+  bool measuring = false;      // Measure mode: taps on the part pick points
   bool ask_quit = false;       // the main thread asked for the quit confirmation (kiosk)
   int width = 0, height = 0;   // framebuffer [px]
   double dt_s = 1.0 / 30;
@@ -65,6 +67,10 @@ class Ui {
   // The controls drawn last frame by label ("Top", "Pause", "##section", ...), for tests
   // and the documentation's screenshots.
   [[nodiscard]] const std::vector<std::pair<const char*, UiRect>>& items() const noexcept { return items_; }
+  // Measure: a picked point (the third starts a new pair), or a tap that met no material.
+  void add_measure(const MeasurePoint& p);
+  void measure_missed() noexcept { measure_miss_ = true; }
+  [[nodiscard]] const std::vector<MeasurePoint>& measured() const noexcept { return measured_; }
 
  private:
   void status_bar(const Renderer& ren, const UiFrameInput& in);
@@ -79,6 +85,8 @@ class Ui {
   void replay_bar(const Renderer& ren);
   void time_slider(ReplayControl& rc, const LiveStats& L);
   void program_panel(const Renderer& ren, const UiFrameInput& in);
+  void measure_panel(const UiFrameInput& in);
+  void mark_points(const UiFrameInput& in);
   void quit_dialog(const UiFrameInput& in, UiActions& act);
   void remember_window();
   bool button(const char* label, const ImVec2& size);
@@ -107,6 +115,9 @@ class Ui {
   std::int64_t scrolled_line_ = -1;
   float replay_h_ = 0;         // height of the replay bar last frame [px]
   float seek_s_ = -1;          // the time slider's value while the operator drags it [s]
+  float program_bottom_ = 0;   // lower edge of the program panel last frame [px]
+  std::vector<MeasurePoint> measured_;  // at most two
+  bool measure_miss_ = false;  // the last tap met no material
 };
 
 }  // namespace lbr::gfx::detail

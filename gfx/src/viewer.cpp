@@ -1,5 +1,7 @@
 #include "gfx/viewer.hpp"
 
+#include <cmath>
+
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
@@ -13,6 +15,8 @@ struct Input {
   bool kiosk = false;
   double x = 0, y = 0;
 };
+
+constexpr double kTapSlopPx = 8.0;  // a tap may wobble this far [px]
 
 Input* input_of(GLFWwindow* w) { return static_cast<Input*>(glfwGetWindowUserPointer(w)); }
 
@@ -28,6 +32,16 @@ void EventRouter::button(int button, bool down, double x, double y) {
     if (!down) ui_owns_ = false;
     return;
   }
+  if (b == 0 && down && !orbiting_ && !panning_ && rt_.measuring()) {
+    tap_armed_ = true;
+    tap_x_ = x, tap_y_ = y;
+    return;
+  }
+  if (b == 0 && !down && tap_armed_) {
+    tap_armed_ = false;
+    rt_.pick(x, y);
+    return;
+  }
   // One-finger (left) drag orbits, or pans when the UI's Pan switch is on; right/middle pan.
   const bool left_pans = rt_.touch_pan();
   if (b == 0) (left_pans ? panning_ : orbiting_) = down;
@@ -41,6 +55,10 @@ void EventRouter::cursor(double x, double y) {
   y_ = y;
   rt_.ui_event({UiEvent::Kind::Move, x, y, 0, false, 0});
   if (ui_owns_) return;
+  if (tap_armed_ && std::hypot(x - tap_x_, y - tap_y_) > kTapSlopPx) {  // a drag after all
+    tap_armed_ = false;
+    (rt_.touch_pan() ? panning_ : orbiting_) = true;
+  }
   if (orbiting_) rt_.edit([&](Camera& c, RenderOptions&) { c.orbit(dx, dy); });
   else if (panning_) {
     const double h = h_px_;

@@ -42,24 +42,29 @@ std::vector<std::uint8_t> to_binary_stl(std::span<const MeshBuffers> regions, co
   return b;
 }
 
-std::vector<std::uint8_t> to_binary_ply(std::span<const MeshBuffers> regions) {
+std::vector<std::uint8_t> to_binary_ply(std::span<const MeshBuffers> regions, std::span<const std::uint8_t> rgb) {
   std::size_t nv = 0, nf = 0;
   for (const MeshBuffers& m : regions) {
     nv += m.vertex_count();
     nf += m.triangle_count();
   }
+  const bool colours = !rgb.empty() && rgb.size() == 3 * nv;
   const std::string head = "ply\nformat binary_little_endian 1.0\ncomment lbrsim reconstruction\nelement vertex " +
                            std::to_string(nv) +
                            "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\n"
-                           "property float ny\nproperty float nz\nproperty float move_id\nelement face " +
+                           "property float ny\nproperty float nz\nproperty float move_id\n" +
+                           std::string(colours ? "property uchar red\nproperty uchar green\nproperty uchar blue\n" : "") +
+                           "element face " +
                            std::to_string(nf) + "\nproperty list uchar int vertex_indices\nend_header\n";
   std::vector<std::uint8_t> b(head.begin(), head.end());
   b.reserve(head.size() + 28 * nv + 13 * nf);
+  std::size_t k = 0;  // vertex index over all regions
   for (const MeshBuffers& m : regions)
-    for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+    for (std::size_t v = 0; v < m.vertex_count(); ++v, ++k) {
       for (int a = 0; a < 3; ++a) put_f32(b, m.positions[3 * v + a]);
       for (int a = 0; a < 3; ++a) put_f32(b, m.normals[3 * v + a]);
       put_f32(b, m.attributes[v]);
+      if (colours) b.insert(b.end(), rgb.begin() + static_cast<std::ptrdiff_t>(3 * k), rgb.begin() + static_cast<std::ptrdiff_t>(3 * k + 3));
     }
   std::uint32_t base = 0;
   for (const MeshBuffers& m : regions) {

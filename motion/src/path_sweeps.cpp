@@ -21,16 +21,13 @@ void sampled_sweeps(const ToolTable& tools, const ChannelPath& c, nc::Emulator& 
   nc::AxisVector prev = c.path.start;
   double t_prev = 0.0;
   nc::Sample s;
-  const std::vector<nc::Emulator::Plan>& plans = em.plans();
-  std::size_t piece = 0;  // the planned piece the sample ends in (samples come in time order)
   while (em.next(s)) {
     if (s.axes != prev) {
       ++out.moves;
       const std::size_t first = out.sweeps.size();
       mapper.map(prev, s.axes, s.tool, static_cast<geom::MoveId>(id_base + s.seq + 1), t_prev, s.t_s, channel,
                  out.sweeps);
-      while (piece + 1 < plans.size() && plans[piece].t0_s + plans[piece].duration_s < s.t_s) ++piece;
-      const int line = piece < plans.size() ? plans[piece].line : 0;
+      const int line = em.line_at(s.t_s);  // the planned piece the sample ends in
       for (std::size_t k = first; k < out.sweeps.size(); ++k) out.sweeps[k].line = line;
     }
     prev = s.axes;

@@ -20,6 +20,7 @@ SampleStream::SampleStream(const ToolTable& tools, const std::array<kin::Kinemat
                            int default_tool, double tol_mm, std::size_t batch_capacity, SweepSink& sink)
     : tools_(tools), kins_(kins), default_tool_(tools.find(default_tool)), tol_(tol_mm), sink_(sink) {
   batch_.reserve(batch_capacity);
+  info_.reserve(batch_capacity);
   for (Channel& c : ch_) c.run.reserve(kMaxRun + 1);
 }
 
@@ -41,9 +42,15 @@ void SampleStream::push(const Channel& c, const geom::Pose& from, const geom::Po
   sink_.on_sweep(r);
   if (batch_.size() == batch_.capacity()) {  // capacity reserved at start-up: empty it now
     sink_.on_batch_full(batch_);
-    batch_.clear();
+    clear_batch();
   }
   batch_.push_back(r);
+  const auto channel = static_cast<int>(&c - ch_.data());
+  info_.push_back({c.run_first, c.run_last, channel, c.tool.number, c.run_fast});
+}
+
+bool SampleStream::fast(const geom::Vec3& a, const geom::Vec3& b, std::uint64_t dseq) const noexcept {
+  return fast_step_mm_ > 0.0 && geom::norm(b - a) > fast_step_mm_ * static_cast<double>(std::max<std::uint64_t>(dseq, 1));
 }
 
 void SampleStream::flush(Channel& c) noexcept {
@@ -65,10 +72,13 @@ void SampleStream::restart(Channel& c, const kin::Kinematics& k, const nc::AxisV
 }
 
 // Rotary axes moved the tool along a curve: n chords within the tolerance.
-void SampleStream::substeps(Channel& c, const kin::Kinematics& k, const nc::AxisVector& q, int n) noexcept {
+void SampleStream::substeps(Channel& c, const kin::Kinematics& k, const nc::AxisVector& q, int n,
+                            std::uint64_t dseq) noexcept {
   flush(c);
   const ToolRef& t = c.tool;
   geom::Pose from = c.run.back();
+  c.run_first = c.run_last = c.seq;  // every chord covers this one sample
+  c.run_fast = fast(from.tip, kin::tool_pose(k, q, t.mount, t.length_mm).tip, dseq);
   for (int i = 1; i <= n; ++i) {
     nc::AxisVector qi = q;
     if (i < n)
@@ -83,16 +93,21 @@ void SampleStream::substeps(Channel& c, const kin::Kinematics& k, const nc::Axis
 }
 
 // A straight move: extend the pending run when it stays straight, else cut it first.
-void SampleStream::extend(Channel& c, const kin::Kinematics& k, const nc::AxisVector& q) noexcept {
+void SampleStream::extend(Channel& c, const kin::Kinematics& k, const nc::AxisVector& q, std::uint64_t dseq) noexcept {
   const geom::Pose p = kin::tool_pose(k, q, c.tool.mount, c.tool.length_mm);
+  const bool step_fast = fast(c.run.back().tip, p.tip, dseq);
   if (c.run.size() >= 2) {
     // Replace the run's straight sweep run[0]→last by run[0]→p only if the tool axis stays
-    // put and every sample of the run stays within the tolerance of the longer sweep.
-    bool straight = c.run.size() < kMaxRun && p.axis == c.run[0].axis && c.run.back().axis == c.run[0].axis;
+    // put, every sample of the run stays within the tolerance of the longer sweep and the
+    // step is of the run's kind (fast or not).
+    bool straight = c.run.size() < kMaxRun && p.axis == c.run[0].axis && c.run.back().axis == c.run[0].axis &&
+                    step_fast == c.run_fast;
     for (std::size_t i = 1; straight && i < c.run.size(); ++i)
       straight = dist_to_segment(c.run[i].tip, c.run[0].tip, p.tip) <= tol_;
     if (!straight) flush(c);
   }
+  if (c.run.size() == 1) c.run_first = c.seq, c.run_fast = step_fast;
+  c.run_last = c.seq;
   c.run.push_back(p);
   c.q = q;
 }
@@ -105,6 +120,7 @@ void SampleStream::take(int channel, std::uint64_t seq, int tool, std::span<cons
   nc::AxisVector q = c.q;
   for (int a = 0; a < nc::kAxes && a < static_cast<int>(sample.size()); ++a)
     if (mask & (1U << a)) q[a] = sample[static_cast<std::size_t>(a)];
+  const std::uint64_t dseq = seq - c.seq;
   c.seq = seq;
   const ToolRef t = tool >= 0 ? tools_.find(tool) : default_tool_;
   if (c.have && !t.same(c.tool)) {  // tool change: the pending run belongs to the old tool
@@ -123,8 +139,8 @@ void SampleStream::take(int channel, std::uint64_t seq, int tool, std::span<cons
   const int n = c.tool.cuts()
                     ? kin::substeps(k, c.q, q, c.tool.mount, c.tool.length_mm, c.tool.reach_mm, tol_)
                     : 1;
-  if (n > 1) substeps(c, k, q, n);
-  else extend(c, k, q);
+  if (n > 1) substeps(c, k, q, n, dseq);
+  else extend(c, k, q, dseq);
 }
 
 }  // namespace lbr::motion

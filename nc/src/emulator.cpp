@@ -82,6 +82,13 @@ void Emulator::state_at(double t_s, AxisVector& axes, int& tool) const noexcept 
   tool = it->tool;
 }
 
+int Emulator::line_at(double t_s) const noexcept {
+  if (plans_.empty() || t_s <= 0.0) return 0;
+  auto it = std::lower_bound(plans_.begin(), plans_.end(), t_s,
+                             [](const Plan& p, double t) { return p.t0_s + p.duration_s < t; });
+  return it == plans_.end() ? plans_.back().line : it->line;
+}
+
 double emulated_time_s(const Toolpath& path, const EmulatorLimits& limits) {
   return Emulator(path, limits).total_time_s();
 }

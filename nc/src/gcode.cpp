@@ -387,7 +387,7 @@ class Interpreter {
     if (std::abs(w.value * 10.0 - c) > 1e-6) return -1;
     switch (c) {
       case 0: case 10: case 20: case 30: case 330: case 331: case 760: case 800: case 810: case 820: case 830: case 730:
-      case 700: case 710: case 720:
+      case 700: case 710: case 711: case 712: case 720: case 721: case 722:
         return kMotion;
       case 170: case 180: case 190: return kPlane;
       case 900: case 910: return kDistance;
@@ -410,9 +410,6 @@ class Interpreter {
   std::string unsupported_g(const Word& w) const {
     const int c = code10(w);
     const char* why = "not supported by the built-in interpreter";
-    if (c == 711 || c == 712 || c == 721 || c == 722)
-      return "unsupported word '" + w.text + "' (lathe roughing cycle variants G71.1/G71.2/G72.1/G72.2 are not in the built-in interpreter" +
-             kUseRs274 + ")";
     if (c == 381 || c == 382 || c == 383 || c == 384) why = "probing";
     else if (c == 431) why = "dynamic tool length offset";
     else if (c == 840 || c == 850 || c == 860 || c == 870 || c == 880 || c == 890) why = "this cycle";
@@ -450,9 +447,10 @@ class Interpreter {
     }
     set_modes(b, k);
     if (k.mstate != nullptr) modal_state(*k.mstate);
-    // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing).
+    // Axis words must exist on the machine (a G10 offset for a missing axis moves nothing; in a
+    // G7x profile A and C are corner finishes).
     for (int a = 0; a < kAxes; ++a)
-      if (has(b, kAxisLetters[a]) && !axis_allowed(a) && k.g10 == 0)
+      if (has(b, kAxisLetters[a]) && !axis_allowed(a) && k.g10 == 0 && !(capture_ != nullptr && (a == 3 || a == 5)))
         fail("word '" + text(b, kAxisLetters[a]) + "' needs an axis the machine lacks (machine kind " + machine_name() + ")");
     move(b, k);
     check_all_words_used(b);
@@ -710,8 +708,25 @@ class Interpreter {
     b_.set_position(b_.from_machine(m));
   }
 
-  // 8. G10, G28/G30, G53; 9. motion
+  // 8. G10, G28/G30, G53; 9. motion. While a G7x profile is recorded, A (fillet) and C
+  // (chamfer) are corner finishes at the move's end, as LinuxCNC reads them there.
   void move(Block& b, const Codes& k) {
+    if (capture_ == nullptr) return move_block(b, k);
+    double radius = 0.0;
+    bool chamfer = false;
+    if (has(b, 'A') && has(b, 'C')) fail("'" + text(b, 'A') + "' and '" + text(b, 'C') + "': a corner takes a fillet or a chamfer");
+    for (char L : {'A', 'C'}) {
+      if (!has(b, L)) continue;
+      radius = len(b, L), chamfer = L == 'C';
+      if (!(radius > 0.0)) fail("'" + text(b, L) + "': a corner finish needs a size > 0");
+      b.has[idx(L)] = false;
+    }
+    const std::size_t before = capture_->size();
+    move_block(b, k);
+    if (radius > 0.0 && capture_->size() > before) capture_->back().corner = radius, capture_->back().chamfer = chamfer;
+  }
+
+  void move_block(Block& b, const Codes& k) {
     if (k.g[kMotion] && is_lathe_profile_cycle(code10(*k.g[kMotion]))) {
       lathe_profile_cycle(b, code10(*k.g[kMotion]), k.f_in_block);
       return;
@@ -1138,71 +1153,69 @@ class Interpreter {
   }
 
   // ---- G70/G71/G72 lathe cycles (lathe_profile.hpp) ----------------------------------------
-  static bool is_lathe_profile_cycle(int c) { return c == 700 || c == 710 || c == 720; }
+  static bool is_lathe_profile_cycle(int c) {
+    return c == 700 || c == 710 || c == 711 || c == 712 || c == 720 || c == 721 || c == 722;
+  }
 
   // The profile: the subroutine Q runs with its moves recorded (not cut), starting from the
   // cycle's start point; then the cycle's own moves are cut.
   void lathe_profile_cycle(Block& b, int c, bool f_in_block) {
-    const std::string g = c == 700 ? "G70" : c == 710 ? "G71" : "G72";
+    const std::string g = "G" + std::to_string(c / 10) + (c % 10 != 0 ? "." + std::to_string(c % 10) : "");
     if (plane_ != Plane::ZX) fail("'" + g + "' needs the XZ plane (G18)");
     if (comp_.active()) fail("'" + g + "' cannot be used with cutter radius compensation on (G40 first)");
     if (!has(b, 'Q')) fail("'" + g + "' needs Q (the number of the profile's subroutine)");
     const int q = integer(b, 'Q', 0, 99999999);
     const AxisVector before = b_.position();
     const AxisVector start = (has(b, 'X') || has(b, 'Z')) ? target(b, false) : before;
-    const bool g72 = c == 720;
-    const detail::ProfilePoint s = profile_point(start, g72, true);
-    const std::vector<detail::ProfilePoint> moves = lathe_cycle_moves(b, g, s, capture_profile(q, start, g72));
+    const detail::LatheCycle cycle = lathe_cycle_words(b, c);
+    const std::vector<detail::LathePoint> profile = capture_profile(q, start);
+    std::vector<detail::LathePoint> moves;
+    try {
+      moves = detail::lathe_cycle(profile, lathe_point(start), cycle);
+    } catch (const std::invalid_argument& e) {
+      fail("'" + g + "': " + e.what());
+    }
     b_.set_position(before);
     b_.rapid(line_, start);
     const double f = feed_for_move(g, f_in_block);
-    for (const detail::ProfilePoint& p : moves) {
+    for (const detail::LathePoint& p : moves) {
       AxisVector v = b_.position();
-      v[g72 ? Z : X] = p.level;
-      v[g72 ? X : Z] = p.pass;
+      v[X] = p.x, v[Z] = p.z;
       if (p.rapid) b_.rapid(line_, v);
       else b_.feed(line_, v, f, inverse_time_);
     }
   }
 
-  std::vector<detail::ProfilePoint> lathe_cycle_moves(Block& b, const std::string& g, const detail::ProfilePoint& s,
-                                                      const std::vector<detail::ProfilePoint>& profile) {
+  // D, E, P (G70) and D, I, R (G71/G72) in program units, as LinuxCNC reads them (radii in G7 too).
+  detail::LatheCycle lathe_cycle_words(Block& b, int c) {
+    detail::LatheCycle k;
+    k.code = c / 10;
+    k.variant = c % 10;
     auto word = [&](char L, double dflt) { return has(b, L) ? len(b, L) : dflt; };
-    try {
-      if (g == "G70") {
-        // Pass i of P runs at E + (D - E)(P - i)/P from the profile (LinuxCNC): on it when E = 0
-        // and D = 0 or P = 1.
-        const int passes = has(b, 'P') ? integer(b, 'P', 1, 1000) : 1;
-        if (word('E', 0.0) != 0.0 || (word('D', 0.0) != 0.0 && passes > 1))
-          fail("'G70' with passes away from the profile (E, or D with P > 1) is not in the built-in interpreter" +
-               std::string(kUseRs274));
-        std::vector<detail::ProfilePoint> out;
-        for (int i = 0; i < passes; ++i) {
-          const std::vector<detail::ProfilePoint> one = detail::lathe_finishing(profile, s);
-          out.insert(out.end(), one.begin(), one.end());
-        }
-        return out;
-      }
-      if (word('D', 0.0) != 0.0)
-        fail("'" + g + "' with D (finishing allowance) is not in the built-in interpreter" + std::string(kUseRs274));
-      return detail::lathe_roughing(profile, s, word('I', 1.0), word('R', 0.5));
-    } catch (const std::invalid_argument& e) {
-      fail("'" + g + "': " + e.what());
+    k.allowance = word('D', 0.0);
+    if (k.code == 70) {
+      k.end_allowance = word('E', 0.0);
+      k.passes = has(b, 'P') ? integer(b, 'P', 1, 1000) : 1;
+    } else {
+      k.increment = word('I', 1.0);
+      k.retract = word('R', 0.5);
     }
+    return k;
   }
 
-  detail::ProfilePoint profile_point(const AxisVector& v, bool g72, bool rapid) const {
-    detail::ProfilePoint p;
-    p.level = v[g72 ? Z : X], p.pass = v[g72 ? X : Z], p.rapid = rapid;
+  detail::LathePoint lathe_point(const AxisVector& v) const {
+    detail::LathePoint p;
+    p.x = v[X], p.z = v[Z];
     return p;
   }
 
-  std::vector<detail::ProfilePoint> capture_profile(int q, const AxisVector& start, bool g72) {
-    std::vector<detail::ProfilePoint> profile;
+  // The subroutine's F words do not change the cycle's feed (LinuxCNC ignores them there).
+  std::vector<detail::LathePoint> capture_profile(int q, const AxisVector& start) {
+    std::vector<detail::LathePoint> profile;
     const int motion = motion_, line = line_;
+    const double feed = feed_;
     b_.set_position(start);
     capture_ = &profile;
-    capture_g72_ = g72;
     try {
       flow_.call_now(std::to_string(q));
     } catch (...) {
@@ -1210,12 +1223,14 @@ class Interpreter {
       throw;
     }
     capture_ = nullptr;
-    motion_ = motion, line_ = line;
+    motion_ = motion, line_ = line, feed_ = feed;
     return profile;
   }
 
   void capture_point(const AxisVector& t, bool rapid) {
-    capture_->push_back(profile_point(t, capture_g72_, rapid));
+    detail::LathePoint p = lathe_point(t);
+    p.rapid = rapid;
+    capture_->push_back(p);
     b_.set_position(t);
   }
 
@@ -1371,8 +1386,7 @@ class Interpreter {
   detail::ControlFlow flow_;
   detail::CutterComp comp_{b_, [this](const std::string& m) { fail(m); }};
   bool arc_after_g40_ = false;  // the move after G40 must be straight (LinuxCNC)
-  std::vector<detail::ProfilePoint>* capture_ = nullptr;  // G70-G72: the profile subroutine's moves go here
-  bool capture_g72_ = false;
+  std::vector<detail::LathePoint>* capture_ = nullptr;  // G70-G72: the profile subroutine's moves go here
   std::map<int, ModalState> saved_states_;  // M70/M73, per call level
   int comp_code_ = 400;                      // G41/G42/G41.1/G42.1 x 10 while compensation is on
   std::vector<detail::ParamAssign> pending_;

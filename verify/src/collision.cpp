@@ -55,11 +55,15 @@ CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::Tool
   }
 }
 
-int CollisionChecker::findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, Finding (&out)[3]) {
+int CollisionChecker::findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, int rapid,
+                                  Finding (&out)[3]) {
   int n = 0;
   if (m.ref.shape == nullptr) return 0;  // turning inserts and tool 0: not checked
-  const nc::Segment* seg = index_.find(m.ref.id, nullptr);
-  if (seg != nullptr && seg->kind == nc::SegmentKind::Rapid) {
+  if (rapid < 0) {
+    const nc::Segment* seg = index_.find(m.ref.id, nullptr);
+    rapid = seg != nullptr && seg->kind == nc::SegmentKind::Rapid ? 1 : 0;
+  }
+  if (rapid > 0) {
     const Intrusion in = probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm);
     if (in.deep_mm3 > 0.0) out[n++] = {EventKind::RapidIntoMaterial, in};
   }
@@ -100,10 +104,16 @@ Event CollisionChecker::event_of(const motion::TimedSweep& m, const Finding& f) 
 
 std::size_t CollisionChecker::check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                                     std::size_t from, std::size_t to, std::vector<Event>& events) {
+  return check(solid, moves, {}, from, to, events);
+}
+
+std::size_t CollisionChecker::check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
+                                    std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to,
+                                    std::vector<Event>& events) {
   if (!config_.enabled) return to;
   Finding found[3];
   for (std::size_t i = from; i < to; ++i) {
-    const int n = findings_of(solid, moves[i], found);
+    const int n = findings_of(solid, moves[i], rapid.empty() ? -1 : (rapid[i] != 0 ? 1 : 0), found);
     if (n > 0 && i > from) return i;
     for (int k = 0; k < n; ++k) add_event(events, event_of(moves[i], found[k]));
   }

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "geom/sweep.hpp"
@@ -17,24 +19,91 @@ struct Nearest {
   double qx = 0, qy = 0;  // the nearest boundary point [units]
 };
 
-// The point of the contours `paths` nearest to p [units].
-Nearest nearest_boundary(const geom::Paths& paths, const geom::Point& p) {
-  Nearest n;
-  const double px = static_cast<double>(p.X), py = static_cast<double>(p.Y);
-  for (const geom::Path& path : paths)
-    for (std::size_t i = 0; i < path.size(); ++i) {
-      const geom::Point& a = path[i];
-      const geom::Point& b = path[(i + 1) % path.size()];
-      const double ax = static_cast<double>(a.X), ay = static_cast<double>(a.Y);
-      const double dx = static_cast<double>(b.X) - ax, dy = static_cast<double>(b.Y) - ay;
-      const double len2 = dx * dx + dy * dy;
-      const double t = len2 > 0.0 ? std::clamp(((px - ax) * dx + (py - ay) * dy) / len2, 0.0, 1.0) : 0.0;
-      const double qx = ax + t * dx, qy = ay + t * dy;
-      const double d = std::hypot(px - qx, py - qy);
-      if (d < n.dist_units) n = {d, qx, qy};
-    }
-  return n;
+// p's distance to the edge a–b and the nearest point, kept in `n` when nearer [units].
+void nearer(const geom::Point& a, const geom::Point& b, double px, double py, Nearest& n) {
+  const double ax = static_cast<double>(a.X), ay = static_cast<double>(a.Y);
+  const double dx = static_cast<double>(b.X) - ax, dy = static_cast<double>(b.Y) - ay;
+  const double len2 = dx * dx + dy * dy;
+  const double t = len2 > 0.0 ? std::clamp(((px - ax) * dx + (py - ay) * dy) / len2, 0.0, 1.0) : 0.0;
+  const double qx = ax + t * dx, qy = ay + t * dy;
+  const double d2 = (px - qx) * (px - qx) + (py - qy) * (py - qy);
+  if (d2 < n.dist_units * n.dist_units) n = {std::sqrt(d2), qx, qy};
 }
+
+// A uniform grid over the edges of one level's design section, for nearest-boundary queries
+// (docs/performance.md "Design comparison"): each cell lists the edges whose bounding box
+// meets it; a query visits rings of cells around the point until the nearest edge found is
+// closer than any unvisited cell: the same point as a scan of every edge (up to ties).
+class EdgeGrid {
+ public:
+  explicit EdgeGrid(const geom::Paths& paths) {
+    for (const geom::Path& path : paths)
+      for (std::size_t i = 0; i < path.size(); ++i) edges_.push_back({path[i], path[(i + 1) % path.size()]});
+    if (edges_.empty()) return;
+    for (const auto& [a, b] : edges_) box_.add(a), box_.add(b);
+    const double w = static_cast<double>(box_.x1 - box_.x0) + 1.0, h = static_cast<double>(box_.y1 - box_.y0) + 1.0;
+    // About two edges a cell, at most 512 x 512 cells.
+    const double cells = std::clamp(static_cast<double>(edges_.size()) / 2.0, 1.0, 512.0 * 512.0);
+    cell_ = std::max(1.0, std::sqrt(w * h / cells));
+    nx_ = std::clamp(static_cast<int>(std::ceil(w / cell_)), 1, 4096);
+    ny_ = std::clamp(static_cast<int>(std::ceil(h / cell_)), 1, 4096);
+    fill();
+  }
+
+  [[nodiscard]] Nearest nearest(const geom::Point& p) const {
+    Nearest n;
+    if (edges_.empty()) return n;
+    const double px = static_cast<double>(p.X), py = static_cast<double>(p.Y);
+    const int cx = cell_x(px), cy = cell_y(py);
+    // A point outside the grid is at least `outside` from every cell.
+    const double outside = std::max({static_cast<double>(box_.x0) - px, px - static_cast<double>(box_.x1),
+                                     static_cast<double>(box_.y0) - py, py - static_cast<double>(box_.y1), 0.0});
+    for (int r = 0; r <= std::max(nx_, ny_); ++r) {
+      for (int y = cy - r; y <= cy + r; ++y)
+        for (int x = cx - r; x <= cx + r; ++x) {
+          if (std::max(std::abs(x - cx), std::abs(y - cy)) != r || x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
+          const auto c = static_cast<std::size_t>(y * nx_ + x);
+          for (std::uint32_t k = start_[c]; k < start_[c + 1]; ++k) nearer(edges_[list_[k]].first, edges_[list_[k]].second, px, py, n);
+        }
+      // Every unvisited cell is at least r cells (and `outside`) away.
+      if (n.dist_units <= std::max(static_cast<double>(r) * cell_, outside)) break;
+    }
+    return n;
+  }
+
+ private:
+  [[nodiscard]] int cell_x(double x) const { return std::clamp(static_cast<int>((x - static_cast<double>(box_.x0)) / cell_), 0, nx_ - 1); }
+  [[nodiscard]] int cell_y(double y) const { return std::clamp(static_cast<int>((y - static_cast<double>(box_.y0)) / cell_), 0, ny_ - 1); }
+
+  // Counting sort of (cell, edge) pairs into start_ / list_.
+  void fill() {
+    start_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_) + 1, 0);
+    for (int pass = 0; pass < 2; ++pass) {
+      if (pass == 1) {
+        for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+        list_.resize(start_.back());
+        next_.assign(start_.begin(), start_.end() - 1);
+      }
+      for (std::size_t e = 0; e < edges_.size(); ++e) {
+        const auto& [a, b] = edges_[e];
+        const int x0 = cell_x(static_cast<double>(std::min(a.X, b.X))), x1 = cell_x(static_cast<double>(std::max(a.X, b.X)));
+        const int y0 = cell_y(static_cast<double>(std::min(a.Y, b.Y))), y1 = cell_y(static_cast<double>(std::max(a.Y, b.Y)));
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x) {
+            const auto c = static_cast<std::size_t>(y * nx_ + x);
+            if (pass == 0) ++start_[c + 1];
+            else list_[next_[c]++] = static_cast<std::uint32_t>(e);
+          }
+      }
+    }
+  }
+
+  std::vector<std::pair<geom::Point, geom::Point>> edges_;
+  geom::Rect box_;
+  double cell_ = 1.0;
+  int nx_ = 1, ny_ = 1;
+  std::vector<std::uint32_t> start_, list_, next_;
+};
 
 double area_mm2(const geom::Paths& paths) {
   double a = 0.0;
@@ -48,6 +117,7 @@ class LevelCompare {
   LevelCompare(const geom::LbrSolid& solid, double tolerance_mm) : solid_(solid), tol_mm_(tolerance_mm) {}
 
   void run(const geom::Paths& design, int level, DesignLevel& lv, DesignReport& rep) {
+    grid_.reset();  // built when this level has a gouge or an excess to measure
     grown_.clear();
     offset_.Clear();
     offset_.ArcTolerance = 10.0;  // 1 µm
@@ -97,7 +167,12 @@ class LevelCompare {
   // Gouge depth: sampled at kSamplesPerEdge points along each gouge edge (the deepest point
   // of a gouge sliver lies on its cut side, not always at a vertex).
   static constexpr int kSamplesPerEdge = 8;
-  void depths(const geom::Paths& design, int level, DesignLevel& lv, DesignReport& rep) const {
+  const EdgeGrid& grid(const geom::Paths& design) {
+    if (!grid_) grid_.emplace(design);
+    return *grid_;
+  }
+
+  void depths(const geom::Paths& design, int level, DesignLevel& lv, DesignReport& rep) {
     for (const geom::Path& p : opened_)
       for (std::size_t i = 0; i < p.size(); ++i)
         for (int k = 0; k < kSamplesPerEdge; ++k) {
@@ -110,15 +185,15 @@ class LevelCompare {
         }
     for (const geom::Path& p : excess_)
       for (const geom::Point& v : p) {
-        const double d_mm = design.empty() ? 0.0 : nearest_boundary(design, v).dist_units * geom::kMmPerUnit;
+        const double d_mm = design.empty() ? 0.0 : grid(design).nearest(v).dist_units * geom::kMmPerUnit;
         lv.max_excess_mm = std::max(lv.max_excess_mm, d_mm);
       }
   }
 
   // One sample point `v` of a gouge contour: its depth into the design.
-  void gouge_point(const geom::Paths& design, const geom::Point& v, int level, DesignLevel& lv, DesignReport& rep) const {
+  void gouge_point(const geom::Paths& design, const geom::Point& v, int level, DesignLevel& lv, DesignReport& rep) {
     const double z = solid_.level_z_mm(level);
-    const Nearest n = nearest_boundary(design, v);
+    const Nearest n = grid(design).nearest(v);
     const double d_mm = n.dist_units * geom::kMmPerUnit;
     lv.max_gouge_mm = std::max(lv.max_gouge_mm, d_mm);
     if (d_mm <= rep.max_gouge_mm) return;
@@ -136,6 +211,7 @@ class LevelCompare {
   ClipperLib::ClipperOffset offset_;
   ClipperLib::Clipper c_;
   geom::Paths grown_, stock_, part_, gouge_, excess_, opened_;
+  std::optional<EdgeGrid> grid_;  // the level's design edges
 };
 
 }  // namespace
@@ -178,6 +254,60 @@ void attribute_gouge(DesignReport& report, const geom::LbrSolid& solid, std::spa
       report.gouge_source = source != nullptr ? *source : std::string();
     }
     return;
+  }
+}
+
+namespace {
+
+// Where point p lies against the design: 1 inside the section of its level, 0 outside
+// (above or below the stock too), -1 on a section's boundary.
+int design_side(const std::vector<geom::Paths>& design, const geom::LbrSolid& solid, const geom::Vec3& p) {
+  if (p.z < solid.z_bottom_mm() || p.z > solid.z_top_mm()) return 0;
+  const geom::Paths& d = design[static_cast<std::size_t>(solid.level_at(p.z))];
+  const geom::Point q{geom::to_units(p.x), geom::to_units(p.y)};
+  int inside = 0;
+  for (const geom::Path& path : d) {
+    const int k = ClipperLib::PointInPolygon(q, path);
+    if (k < 0) return -1;
+    inside += k;
+  }
+  return inside % 2;  // the NonZero union's outer contours and holes
+}
+
+}  // namespace
+
+void vertex_deviation(const std::vector<geom::Paths>& design, const geom::LbrSolid& solid,
+                      std::span<const float> positions, std::span<const float> normals, double tolerance_mm,
+                      std::vector<float>& out) {
+  out.assign(positions.size() / 3, 0.0f);
+  if (design.size() != static_cast<std::size_t>(solid.levels())) return;
+  const double half = 0.5 * tolerance_mm;
+  std::vector<std::unique_ptr<EdgeGrid>> grids(design.size());  // per level, when first needed
+  // The in-plane depth of `at` inside (gouge) or outside (excess) the design section [mm].
+  const auto depth_mm = [&](const geom::Vec3& at) {
+    const auto l = static_cast<std::size_t>(solid.level_at(at.z));
+    if (design[l].empty()) return 1e9;
+    if (!grids[l]) grids[l] = std::make_unique<EdgeGrid>(design[l]);
+    return grids[l]->nearest({geom::to_units(at.x), geom::to_units(at.y)}).dist_units * geom::kMmPerUnit;
+  };
+  // A point on a level boundary (cap edges, probes moved sideways from them) belongs to both
+  // levels: `side` must hold on both (1 µm below and above).
+  const auto both = [&](const geom::Vec3& at, int side) {
+    const geom::Vec3 dz{0, 0, 1e-3};
+    return design_side(design, solid, at - dz) == side && design_side(design, solid, at + dz) == side;
+  };
+  for (std::size_t v = 0; v < out.size(); ++v) {
+    const geom::Vec3 p{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]};
+    const geom::Vec3 n{normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]};
+    const geom::Vec3 outside = p + half * n, inside = p - half * n;
+    // Gouge: half the tolerance outside the stock is design material, at least half the
+    // tolerance deep; excess: half the tolerance inside is as far outside the design. A
+    // vertex where a floor meets a wall sits on both within rounding and is neither.
+    if (both(outside, 1)) {
+      if (const double d = depth_mm(outside); d >= half) out[v] = static_cast<float>(-(d + half));
+    } else if (both(inside, 0)) {
+      if (const double d = depth_mm(inside); d >= half) out[v] = static_cast<float>(std::min(d, 1e6) + half);
+    }
   }
 }
 

@@ -42,6 +42,13 @@ void clip_half(const geom::Path& in, int axis, geom::Coord c, bool keep_greater,
   }
 }
 
+// Area of non-overlapping paths [mm²].
+double area_mm2(const geom::Paths& paths) {
+  double units2 = 0.0;
+  for (const geom::Path& p : paths) units2 += ClipperLib::Area(p);
+  return geom::area_to_mm2(std::abs(units2));
+}
+
 }  // namespace
 
 // The part of contour `p` inside `r` (Sutherland–Hodgman). For a non-convex contour the
@@ -133,14 +140,19 @@ Intrusion IntrusionProbe::measure(const geom::LbrSolid& solid, const geom::Sweep
     for (std::size_t k = 0; k < regions_.size(); ++k) {
       const geom::Cell& cell = solid.cell(regions_[k], level);
       if (!cell.bbox.intersects(sb)) continue;
-      cell_subject(cell, sb);
-      const double v = subject_overlap_mm2(section_) * solid.level_thickness_mm(level);
+      // No clip where the section's box lies in the air (a rapid over cleared levels) or,
+      // for one convex section, wholly in the material (the overlap is the section).
+      const geom::RectCover cover = geom::cover_of(cell, sb);
+      if (cover == geom::RectCover::None) continue;
+      const bool whole = cover == geom::RectCover::All && section_.size() == 1;
+      if (!whole) cell_subject(cell, sb);
+      const double v = (whole ? area_mm2(section_) : subject_overlap_mm2(section_)) * solid.level_thickness_mm(level);
       if (v <= 0.0) continue;
       region_volume_[k] += v;
       level_mm3 += v;
       if (out.deep_mm3 > 0.0) continue;  // a finding already: only the volume is still needed
       if (!shrunk) shrink_section(margin_mm), shrunk = true;
-      out.deep_mm3 += subject_overlap_mm2(shrunk_) * solid.level_thickness_mm(level);
+      out.deep_mm3 += (whole ? area_mm2(shrunk_) : subject_overlap_mm2(shrunk_)) * solid.level_thickness_mm(level);
     }
     if (level_mm3 <= 0.0) continue;
     const double bottom = solid.level_bottom_mm(level), top = bottom + solid.level_thickness_mm(level);

@@ -29,6 +29,7 @@ struct BatchResult {
   int threads = 1;              // kernel worker threads used
   std::vector<verify::Event> events;  // collision and process checks (verify/), in move order
   std::optional<verify::DesignReport> design;  // profile.design.stl_path set: the final stock against it
+  std::vector<geom::Paths> design_sections{};   // the sliced design (--design), for deviation colours
 };
 
 // Progress callback: fraction done in [0, 1].

@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/profile.hpp"
@@ -25,6 +26,7 @@
 #include "gfx/exchange.hpp"
 #include "nc/emulator.hpp"
 #include "nc/toolpath.hpp"
+#include "verify/events.hpp"
 
 namespace lbr::app {
 
@@ -39,6 +41,10 @@ struct LiveProgress {
 
 struct LiveOptions {
   std::string source;     // can:IF | serial:DEV | replay:FILE | emulator:PROGRAM
+  // The program the machine runs (can, serial, replay): its line is found from the sampled
+  // positions (nc::LineTracker) and its emulated time is the run's total, for the status bar.
+  // Not used with an emulator source, which knows its line.
+  std::string program;
   double speed = 1.0;     // replay/emulator: 1 = real time, 0 = as fast as possible
   std::string record;     // write the raw input to this file (candump -l format; the emulator's
                           // samples as the serial frames of the profile's mapping)
@@ -99,6 +105,17 @@ struct LiveResult {
   // and the source position it skipped to (0: not resumed).
   std::uint64_t snapshots_written = 0, snapshots_failed = 0, resumed_generation = 0, resumed_position = 0;
   double snapshot_copy_max_ms = 0;  // longest copy of the solid into the writer's slot (geometry thread)
+  // Collision checks (docs/verification.md#live): whether they ran, the speed above which a
+  // sample stream is a rapid [mm/min], the events (sample numbers in move / last_move; lines
+  // and source for emulated programs), events not stored (list full), and the latency from
+  // the offending sample's receive time to the event [ms]; the time the checks took per
+  // kernel call [ms].
+  bool checks = false;
+  double rapid_threshold_mm_per_min = 0;
+  std::vector<verify::Event> events{};
+  std::uint64_t events_dropped = 0, event_latency_count = 0;
+  double event_latency_p50_ms = 0, event_latency_p99_ms = 0, event_latency_max_ms = 0;
+  double check_p50_ms = 0, check_p99_ms = 0, check_max_ms = 0;
 };
 
 using StatusFn = std::function<void(const std::string& line)>;
@@ -125,6 +142,9 @@ class LivePipeline {
   [[nodiscard]] bool running() const noexcept;
   // One status line with the counters so far (the caller's thread, once a second).
   [[nodiscard]] std::string status_line();
+  // The collision events raised since the last call, one line each for the log, with
+  // whether it is an error (control thread; docs/verification.md#live).
+  [[nodiscard]] std::vector<std::pair<bool, std::string>> new_events();
   // A warning about input that does not match the profile, or "" (control thread).
   [[nodiscard]] std::string input_warning() const;
   // Asks the source loop to end without waiting (any thread).

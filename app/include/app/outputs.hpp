@@ -5,8 +5,11 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "app/batch.hpp"
 #include "app/profile.hpp"
+#include "gfx/renderer.hpp"
 #include "nc/toolpath.hpp"
 
 namespace lbr::app {
@@ -35,6 +38,9 @@ std::uint64_t write_samples_csv(const std::string& path, nc::Emulator& emulator)
 // The bundled demo part program (config/programs/demo-pocket.moves, compiled in).
 [[nodiscard]] nc::Toolpath demo_toolpath();
 
+// The checks' keys of metrics.json (docs/formats.md#events): checks, event_errors,
+// event_warnings and the "events" array (fields as the columns of events.csv).
+void put_events_json(const std::vector<verify::Event>& events, bool checks, nlohmann::json& j);
 // Metrics of a batch run as a JSON document (keys in docs/formats.md#metrics).
 [[nodiscard]] std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program);
 
@@ -46,7 +52,18 @@ void write_batch_outputs(const std::string& dir, const BatchResult& r, const Pro
 // Reconstructs the whole part (mesh/, joined walls) and writes it as binary STL and/or PLY;
 // an empty path skips that format. For `lbrsim batch --stl/--ply` and live mode's export on
 // request. Throws std::runtime_error naming the path on I/O failure.
-void write_mesh_files(const geom::LbrSolid& solid, const std::string& stl_path, const std::string& ply_path);
+// With `colours.design`, the PLY's vertices carry deviation colours (gfx::deviation_rgb of
+// verify::vertex_deviation; --color deviation --design, docs/verification.md#deviation-colour).
+struct DeviationColours {
+  const std::vector<geom::Paths>* design = nullptr;  // verify::slice_design() of the model; null: none
+  double tolerance_mm = 0.02;
+};
+void write_mesh_files(const geom::LbrSolid& solid, const std::string& stl_path, const std::string& ply_path,
+                      const DeviationColours& colours = {});
+// The renderer's per-vertex deviation values (gfx::RenderOptions::deviation) for `design`,
+// sliced on the levels of `solid` (both must outlive the renderer).
+[[nodiscard]] gfx::DeviationFn deviation_fn(const std::vector<geom::Paths>& design, const geom::LbrSolid& solid,
+                                            double tolerance_mm);
 
 void write_file(const std::string& path, const std::string& bytes);
 void write_file(const std::string& path, const std::vector<std::uint8_t>& bytes);

@@ -115,4 +115,8 @@ struct ViewOptions {
 // process exit code.
 int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, const ViewOptions& opt);
 
+// A program file's lines (line 1 first, CR of CRLF removed) for the UI's program panel;
+// empty when the file cannot be read (the built-in demo has none).
+[[nodiscard]] std::vector<std::string> program_text(const std::string& file);
+
 }  // namespace lbr::app

@@ -15,13 +15,19 @@ std::array<kin::Kinematics, motion::kMaxChannels> Geometry::channel_kinematics(c
   return k;
 }
 
+std::size_t Geometry::batch_capacity(std::size_t ring_capacity) noexcept {
+  return 2 * ring_capacity + hal::kMaxChannels + kin::kMaxMoveSubsteps;
+}
+
 Geometry::Geometry(geom::LbrSolid& solid, const Profile& profile, const motion::ToolTable& tools, int default_tool,
                    sched::SpscRing<hal::AxisSample>& ring, double tol_mm)
     : solid_(solid),
       ring_(ring),
       stream_(tools, channel_kinematics(profile), default_tool, tol_mm,
-              2 * ring.capacity() + hal::kMaxChannels + kin::kMaxMoveSubsteps, *this) {
+              batch_capacity(ring.capacity()), *this) {
   rx_.resize(ring.capacity());
+  seq_.resize(ring.capacity());
+  chan_.resize(ring.capacity());
   weight_.resize(ring.capacity());
   const std::size_t cells = static_cast<std::size_t>(solid.levels()) * static_cast<std::size_t>(solid.regions());
   if (cells <= (std::size_t{1} << 22)) stamp_.assign(cells, 0);  // else: cells counted per sweep
@@ -119,7 +125,45 @@ void Geometry::kernel(std::span<const geom::SweepRef> part) noexcept {
   if (kernel_delay_ns_ > 0) sched::sleep_until_ns(sched::now_ns() + kernel_delay_ns_);
 }
 
+void Geometry::set_checks(LiveChecks* checks) noexcept {
+  checks_ = checks != nullptr && checks->enabled() ? checks : nullptr;
+  stream_.set_fast_step(checks_ != nullptr ? checks_->fast_step_mm() : 0.0);
+}
+
+std::size_t Geometry::checked(std::size_t i, std::size_t j) noexcept {
+  if (checks_ == nullptr) return j;
+  const std::int64_t t0 = sched::now_ns();
+  const TickSamples tick{std::span<const std::int64_t>(rx_.data(), taken_), std::span<const std::uint64_t>(seq_.data(), taken_),
+                         std::span<const std::uint8_t>(chan_.data(), taken_)};
+  const std::size_t end = checks_->check(solid_, i, j, tick);
+  check_.record(sched::now_ns() - t0);
+  return end;
+}
+
+bool Geometry::apply_pieces(const geom::SweepRef& s, int k) noexcept {
+  // Pieces at geom::Sweep's own interpolated poses.
+  split_.store(split_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  geom::SweepRef piece = s;
+  for (int p = 1; p <= k; ++p) {
+    if (p > 1 && stop_due()) return false;
+    const double t = static_cast<double>(p) / k;
+    piece.from = piece.to;
+    if (p == 1) piece.from = s.from;
+    if (p == k) {
+      piece.to = s.to;
+    } else {
+      piece.to.tip = geom::lerp(s.from.tip, s.to.tip, t);
+      const geom::Vec3 a = geom::lerp(s.from.axis, s.to.axis, t);
+      const double n = geom::norm(a);
+      piece.to.axis = n > 0.0 ? (1.0 / n) * a : s.from.axis;
+    }
+    kernel(std::span<const geom::SweepRef>(&piece, 1));
+  }
+  return true;
+}
+
 bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
+  if (checks_ != nullptr) checks_->begin(batch, stream_.batch_info());
   std::size_t i = 0;
   while (i < batch.size()) {
     if (stop_due()) return false;
@@ -156,27 +200,14 @@ bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
       units += u;
       if (j == i) first = u;
     }
+    // The checks judge the sub-batch against the stock now; a sweep after the first that
+    // meets material ends it (judged again, as the first of the next, once the ones before
+    // it are subtracted).
+    j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
+    j = checked(i, j);
     if (j == i + 1 && first > budget_) {
-      // One sweep over the budget: pieces at geom::Sweep's own interpolated poses.
-      const geom::SweepRef& s = batch[i];
-      const int k = std::min(kMaxPieces, static_cast<int>(std::ceil(first / budget_)));
-      split_.store(split_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-      geom::SweepRef piece = s;
-      for (int p = 1; p <= k; ++p) {
-        if (p > 1 && stop_due()) return false;
-        const double t = static_cast<double>(p) / k;
-        piece.from = piece.to;
-        if (p == 1) piece.from = s.from;
-        if (p == k) {
-          piece.to = s.to;
-        } else {
-          piece.to.tip = geom::lerp(s.from.tip, s.to.tip, t);
-          const geom::Vec3 a = geom::lerp(s.from.axis, s.to.axis, t);
-          const double n = geom::norm(a);
-          piece.to.axis = n > 0.0 ? (1.0 / n) * a : s.from.axis;
-        }
-        kernel(std::span<const geom::SweepRef>(&piece, 1));
-      }
+      // One sweep over the budget: cut into pieces.
+      if (!apply_pieces(batch[i], std::min(kMaxPieces, static_cast<int>(std::ceil(first / budget_))))) return false;
     } else {
       kernel(batch.subspan(i, j - i));
     }
@@ -189,13 +220,18 @@ std::size_t Geometry::tick(std::size_t limit) {
   stream_.clear_batch();
   abandoned_ = false;
   std::size_t n = 0;
+  taken_ = 0;
   limit = std::min(limit, rx_.size());
   while (n < limit) {
     hal::AxisSample* s = ring_.front();
     if (s == nullptr) break;
+    rx_[n] = s->t_rx_ns;  // before take(): a full motion batch is applied (and checked) inside it
+    seq_[n] = s->seq;
+    chan_[n] = s->channel;
+    taken_ = n + 1;
     stream_.take(s->channel, s->seq, s->tool, s->q, s->mask);
     if (s->channel < hal::kMaxChannels) pending_[s->channel] = *s, pending_have_[s->channel] = true;
-    rx_[n] = s->t_rx_ns;
+    if (pos_ != nullptr) pos_->on_sample(*s);
     weight_[n++] = 1 + s->coalesced;
     ring_.pop();
   }

@@ -26,8 +26,10 @@
 
 #include "app/profile.hpp"
 #include "geom/lbr_solid.hpp"
+#include "live/checks.hpp"
 #include "gfx/exchange.hpp"
 #include "hal/sample.hpp"
+#include "live/program_position.hpp"
 #include "motion/sample_stream.hpp"
 #include "motion/tool_table.hpp"
 #include "sched/latency_stats.hpp"
@@ -41,6 +43,9 @@ class Geometry final : public motion::SweepSink {
   // tool number. Setup: allocates the batch and lag buffers.
   Geometry(geom::LbrSolid& solid, const Profile& profile, const motion::ToolTable& tools, int default_tool,
            sched::SpscRing<hal::AxisSample>& ring, double tol_mm);
+
+  // Sweeps the motion stream buffers before a kernel call is forced (on_batch_full).
+  [[nodiscard]] static std::size_t batch_capacity(std::size_t ring_capacity) noexcept;
 
   // Applies what is in the ring, at most `limit` ring entries; returns the entries taken.
   std::size_t tick(std::size_t limit);
@@ -68,6 +73,14 @@ class Geometry final : public motion::SweepSink {
   // Estimated work of one sweep alone (cells it reaches + its sections).
   [[nodiscard]] double work_units(const geom::SweepRef& s) const noexcept;
 
+  // Collision checks (live/checks.hpp) before every kernel call; null: none. Setup: also
+  // sets the motion stream's fast-step threshold (rapids).
+  void set_checks(LiveChecks* checks) noexcept;
+  // Duration of the checks before each kernel call.
+  [[nodiscard]] const sched::LatencyHistogram& check_time() const noexcept { return check_; }
+
+  // Every sample taken from the ring also goes to `pos` (the status bar's program position).
+  void set_program_position(ProgramPosition* pos) noexcept { pos_ = pos; }
   // Rendering: tip points go to the exchange's path buffer (no allocation).
   void set_exchange(gfx::SolidExchange* ex) noexcept { ex_ = ex; }
   // Publishes the solid to the render side between batches (never waits; see
@@ -107,6 +120,10 @@ class Geometry final : public motion::SweepSink {
   // Subtracts `batch` in sub-batches within the work budget; false when a stop cut it short.
   bool apply(std::span<const geom::SweepRef> batch) noexcept;
   void kernel(std::span<const geom::SweepRef> part) noexcept;
+  // The end of the prefix of [i, j) the kernel may subtract now (the checks' verdict).
+  std::size_t checked(std::size_t i, std::size_t j) noexcept;
+  // Subtracts the single sweep s in k pieces; false when a stop cut it short.
+  bool apply_pieces(const geom::SweepRef& s, int k) noexcept;
   // Cells of one sweep [levels l0..l1] x [regions x0..x1, y0..y1]; false when it reaches none.
   struct Reach {
     int l0 = 0, l1 = -1, x0 = 0, x1 = -1, y0 = 0, y1 = -1;
@@ -118,6 +135,10 @@ class Geometry final : public motion::SweepSink {
   sched::SpscRing<hal::AxisSample>& ring_;
   motion::SampleStream stream_;
   std::vector<std::int64_t> rx_;
+  std::vector<std::uint64_t> seq_;         // sequence number of ring entry i of this tick
+  std::vector<std::uint8_t> chan_;         // its channel
+  std::size_t taken_ = 0;                  // ring entries taken in this tick so far
+  LiveChecks* checks_ = nullptr;
   std::vector<std::uint32_t> weight_;      // 1 + samples folded into ring entry i
   std::vector<std::uint32_t> stamp_;       // per (region, level): sub-batch that counted it
   std::uint32_t stamp_gen_ = 0;
@@ -128,11 +149,12 @@ class Geometry final : public motion::SweepSink {
   std::atomic<std::int64_t>* stop_ns_ = nullptr;
   std::int64_t stop_grace_ns_ = 0;
   bool abandoned_ = false;
-  sched::LatencyHistogram lag_, work_;
+  sched::LatencyHistogram lag_, work_, check_;
   std::atomic<std::uint64_t> applied_{0}, sweeps_{0}, batches_{0}, coalesced_{0}, calls_{0}, split_{0}, unapplied_{0};
   std::atomic<double> removed_{0.0};
   int ticks_since_volume_ = 0;
   gfx::SolidExchange* ex_ = nullptr;
+  ProgramPosition* pos_ = nullptr;
   std::int64_t last_rx_ns_ = 0;
   std::array<bool, hal::kMaxChannels> have_{}, pending_have_{};
   std::array<hal::AxisSample, hal::kMaxChannels> last_{}, pending_{};

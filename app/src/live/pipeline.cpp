@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "app/live.hpp"
+#include "app/outputs.hpp"
 #include "geom/lbr_solid.hpp"
 #include "live/geometry.hpp"
 #include "live/ring_sink.hpp"
@@ -44,6 +45,9 @@ struct LivePipeline::Impl {
   std::unique_ptr<live::SkipSink> skip_sink;  // resumed replay: drops what the solid holds
   hal::SampleSink* input = nullptr;            // what the source delivers to
   std::unique_ptr<Geometry> geo;
+  std::unique_ptr<live::LiveChecks> checks;  // collision checks on the geometry thread (null: off)
+  std::shared_ptr<const nc::Emulator> emulator;        // an emulator source's (its plan)
+  std::unique_ptr<live::ProgramPosition> position;     // line, machining time for the status bar
   // Power-loss snapshots (app/snapshot.hpp): the writer, its period, and where a resumed
   // run started (the source's sample numbers restart at 1 after an emulator skip).
   std::unique_ptr<SnapshotWriter> snap;
@@ -109,6 +113,8 @@ gfx::LiveStats live_stats(const LivePipeline::Impl& p) {
   st.samples_coalesced = p.sink->coalesced();
   st.samples_held = p.sink->held();
   st.realtime = p.hal_mode.load(std::memory_order_relaxed) == 1 && p.geo_mode.load(std::memory_order_relaxed) == 1;
+  if (p.checks) p.checks->fill_alarms(st);
+  if (p.position) p.position->fill(st);
   return st;
 }
 
@@ -305,6 +311,35 @@ void start_snapshots(LivePipeline::Impl& p) {
   p.snapshot_period_ns = static_cast<std::int64_t>(p.profile.live.snapshot_s * 1e9);
 }
 
+// The collision checks' results into r (after the geometry thread has ended).
+void fill_check_results(const LivePipeline::Impl& p, LiveResult& r) {
+  r.checks = p.checks != nullptr;
+  if (!p.checks) return;
+  const auto ms = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-6; };
+  r.rapid_threshold_mm_per_min = p.checks->rapid_threshold_mm_per_min();
+  r.events = p.checks->events();
+  r.events_dropped = p.checks->dropped();
+  const sched::LatencyHistogram& lat = p.checks->latency();
+  r.event_latency_count = lat.count();
+  r.event_latency_p50_ms = ms(lat.percentile_ns(0.5));
+  r.event_latency_p99_ms = ms(lat.percentile_ns(0.99));
+  r.event_latency_max_ms = ms(lat.max_ns());
+  const sched::LatencyHistogram& ct = p.geo->check_time();
+  r.check_p50_ms = ms(ct.percentile_ns(0.5));
+  r.check_p99_ms = ms(ct.percentile_ns(0.99));
+  r.check_max_ms = ms(ct.max_ns());
+}
+
+// The status bar's program position: the emulator source's plan, or --program's moves.
+void configure_program(LivePipeline::Impl& p) {
+  std::optional<nc::Toolpath> program;
+  if (!p.opt.program.empty() && !p.emulator) program = load_toolpath(p.opt.program, p.profile);
+  p.position = std::make_unique<live::ProgramPosition>(p.emulator, program ? &*program : nullptr,
+                                                       live_emulator_limits(p.profile), p.profile.live.period_ms * 1e-3,
+                                                       p.seq_base);
+  p.geo->set_program_position(p.position.get());
+}
+
 geom::SolidSpec live_solid_spec(const Profile& profile, const motion::ToolTable& tools) {
   geom::SolidSpec spec = profile.solid;
   if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tools.max_diameter());
@@ -338,7 +373,7 @@ void LivePipeline::configure() {
   p.seq_base = resume != nullptr && emulator ? resume->source_position : 0;
   start_snapshots(p);
 
-  p.src = live::make_source(profile, p.opt.source, p.opt.speed, p.seq_base);
+  p.src = live::make_source(profile, p.opt.source, p.opt.speed, p.seq_base, &p.emulator);
   p.src->open();
   p.backpressure = !p.src->live();
   p.ring = std::make_unique<sched::SpscRing<hal::AxisSample>>(cfg.ring_capacity);
@@ -363,6 +398,12 @@ void LivePipeline::configure() {
     p.input = p.skip_sink.get();
   }
   p.geo = std::make_unique<Geometry>(p.r->solid, profile, *p.tools, cfg.tool, *p.ring, cfg.merge_tolerance_mm);
+  if (profile.checks.enabled) {
+    p.checks = std::make_unique<live::LiveChecks>(profile, *p.tools, Geometry::batch_capacity(p.ring->capacity()),
+                                                  live::ProgramLines(p.emulator, emulator ? p.opt.source.substr(9) : "",
+                                                                     p.seq_base));
+    p.geo->set_checks(p.checks.get());
+  }
   if (resume != nullptr && (emulator || replay)) {  // a live machine has moved on: no sweep across the outage
     std::array<hal::AxisSample, hal::kMaxChannels> last = resume->last;
     for (hal::AxisSample& s : last) s.seq = s.seq >= p.seq_base ? s.seq - p.seq_base : 0;
@@ -372,6 +413,7 @@ void LivePipeline::configure() {
   p.geo->set_kernel_delay_ns(p.opt.test_kernel_delay_ns);
   if (p.opt.test_work_budget > 0) p.geo->set_work_budget(p.opt.test_work_budget);
   p.geo->set_exchange(p.opt.exchange);
+  configure_program(p);
   if (p.opt.on_start) p.opt.on_start(p.r->solid);
   p.r->solid.clear_dirty();  // the render side starts from this state
 }
@@ -420,6 +462,29 @@ std::string LivePipeline::status_line() {
   return line;
 }
 
+std::vector<std::pair<bool, std::string>> LivePipeline::new_events() {
+  Impl& p = *impl_;
+  std::vector<std::pair<bool, std::string>> out;
+  if (!p.checks) return out;
+  live::EventNote n;
+  while (p.checks->pop_note(n)) {
+    verify::Event e;
+    e.kind = n.kind;
+    e.source = n.line > 0 ? p.checks->program() : "";
+    e.line = n.line;
+    e.move = static_cast<geom::MoveId>(n.sample & 0xFFFFFFFFU);
+    e.tool = n.tool;
+    e.channel = n.channel;
+    e.position = n.position;
+    e.volume_mm3 = n.volume_mm3;
+    e.depth_mm = n.depth_mm;
+    char tail[96];
+    std::snprintf(tail, sizeof tail, " (sample %" PRIu64 ", raised %.2f ms after it was received)", n.sample, n.latency_ms);
+    out.emplace_back(e.severity() == verify::Severity::Error, verify::describe(e) + tail);
+  }
+  return out;
+}
+
 void LivePipeline::request_stop() noexcept { impl_->stop_requested.store(true, std::memory_order_relaxed); }
 
 void LivePipeline::stop() {
@@ -454,6 +519,7 @@ LiveResult LivePipeline::result() {
     const auto f = static_cast<hal::Fault>(k);
     r.decode_errors[hal::fault_name(f)] = p.src->counters().get(f) + p.sink->counters().get(f);
   }
+  fill_check_results(p, r);
   const bool fifo = p.hal_mode.load() == 1 && p.geo_mode.load() == 1;
   r.rt_mode = fifo ? "fifo" : "non-rt";
   if (p.snap) {  // clean shutdown: the final state, after any periodic one still being written

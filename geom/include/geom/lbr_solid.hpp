@@ -45,6 +45,19 @@ struct Cell {
                              // (colour by time of a floor whose level above was cut away)
 };
 
+// How a rectangle meets the material of a cell (cover_of()).
+enum class RectCover : std::uint8_t {
+  None,    // no material in the rectangle
+  All,     // the rectangle lies inside the material
+  Partly,  // some contour edge comes near the rectangle: only a clip tells
+};
+
+// Where rectangle r lies against the cell's material: when no contour edge's box meets r,
+// r lies wholly inside or wholly outside the material and its centre decides which.
+// Conservative (Partly where an edge's box meets r but the edge misses it). O(vertices of
+// the polygons whose box meets r), no allocation.
+[[nodiscard]] RectCover cover_of(const Cell& cell, const Rect& r) noexcept;
+
 struct BoxStock {
   Vec3 min, max;  // [mm]
 };
@@ -77,6 +90,17 @@ struct SweepRef {
   MoveId id = 0;
   const TurningShape* turning = nullptr;
 };
+
+// Where a batch of `moves` should end so that the path in it does not come round on itself
+// in a tight loop: the number of leading moves (at least one, at most moves.size()) before
+// the XY path of consecutive milling moves of one tool has turned a full circle while
+// staying within a square of side kTightLoopDiameters tool diameters. A tight helix (a bore,
+// a ramp entry, thread milling) turns on one spot, and one difference fed with several of
+// its turns carries every turn's outline over the same annulus: the Vatti sweep's cost grows
+// with the square of those crossing edges, while batches of one turn each stay linear.
+// Loops wider than that (a pocket's passes) are not cut. Real-time safe.
+inline constexpr double kTightLoopDiameters = 2.0;
+[[nodiscard]] std::size_t tight_loop_end(std::span<const SweepRef> moves) noexcept;
 
 struct SubtractStats {
   std::uint64_t sections = 0;       // section polygons computed

@@ -132,7 +132,9 @@ class Sweep {
  private:
   std::size_t section_vertical(double z_mm, Paths& out, SectionScratch& scratch) const;
   std::size_t section_general(double z_mm, Paths& out, SectionScratch& scratch, const Rect* material) const;
-  void ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<SectionScratch::P2>& uc) const;
+  // The hull of sc.disks on the n-grid in sc.hull (with hull_role, hull_grid); ends_only keeps
+  // only the first and last vertex of each run of directions one end disk wins.
+  void ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<SectionScratch::P2>& uc, bool ends_only) const;
   // The disks whose hull is the section on z = zc (vertical sweeps); false when none.
   bool section_disks(double zc, SectionScratch& sc) const;
 

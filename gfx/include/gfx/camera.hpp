@@ -44,6 +44,9 @@ class Camera {
   // Window coordinates of a point (x right, y *down* from the top-left pixel corner, as in
   // a PNG), for a viewport of w × h pixels.
   [[nodiscard]] glm::dvec2 project(const glm::dvec3& p, int w, int h) const noexcept;
+  // The inverse: the line of sight through window point (x, y) as origin (on the near plane)
+  // + t · dir, t in [0, 1] reaching the far plane. project() of any point on it gives (x, y).
+  void ray(double x, double y, int w, int h, glm::dvec3& origin, glm::dvec3& dir) const noexcept;
 };
 
 // The six planes of a view-projection matrix (Gribb–Hartmann), for box culling.

@@ -17,6 +17,7 @@ struct CaptureOptions {
   int width = 1024, height = 768;
   bool ortho = false;  // orthographic projection (the default for the top view)
   bool hud = false;
+  DeviationFn deviation;  // ColorMode::Deviation's per-vertex values (RenderOptions::deviation)
 };
 
 // Parses "WxH" (e.g. 1024x768); throws std::invalid_argument.

@@ -93,6 +93,13 @@ class RenderThread {
   [[nodiscard]] bool quit_confirmed() const noexcept { return quit_.load(std::memory_order_acquire); }
   // One-finger drag pans instead of orbiting (the UI's Orbit / Pan switch).
   [[nodiscard]] bool touch_pan() const noexcept { return touch_pan_.load(std::memory_order_relaxed); }
+  // Measure mode (the UI's Measure switch): a tap on the 3D view picks a point.
+  [[nodiscard]] bool measuring() const noexcept { return measuring_.load(std::memory_order_relaxed); }
+  // Picks the part's point under window point (x, y) at the next frame (at most 8 waiting).
+  void pick(double x, double y);
+  // The Measure panel's points as of the last frame (0 to 2) and taps that met no material.
+  [[nodiscard]] std::vector<MeasurePoint> measured();
+  [[nodiscard]] std::uint64_t measure_misses();
   // The next shown frame as drawn, UI included (visible windows); waits up to timeout_s and
   // returns an empty image when no frame came.
   [[nodiscard]] Image capture(double timeout_s);
@@ -110,6 +117,7 @@ class RenderThread {
   void apply_ui(const detail::UiActions& act);
   FrameInfo draw(Renderer& ren, const Camera& cam, int w, int h, double dt_s);
   void serve_capture(int w, int h);
+  void serve_picks(Renderer& ren, const Camera& cam, int w, int h);
 
   Window& win_;
   SolidExchange& ex_;
@@ -132,8 +140,11 @@ class RenderThread {
   std::vector<std::pair<std::string, UiRect>> ui_items_;
   bool ui_modal_ = false, ask_quit_ = false, capture_req_ = false, capture_done_ = false;
   Image capture_;
+  std::vector<std::pair<double, double>> picks_;  // taps waiting for the Measure tool [px]
+  std::vector<MeasurePoint> measured_;
+  std::uint64_t measure_misses_ = 0;
   std::condition_variable capture_cv_;
-  std::atomic<bool> quit_{false}, touch_pan_{false};
+  std::atomic<bool> quit_{false}, touch_pan_{false}, measuring_{false};
 };
 
 }  // namespace lbr::gfx

@@ -4,7 +4,9 @@
 // Allocates; never used on the real-time threads.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <deque>
 #include <memory>
 #include <string>
@@ -16,10 +18,18 @@
 
 namespace lbr::gfx {
 
-enum class ColorMode { Plain, Heat, Regions };
-// Parses "plain", "heat", "regions"; throws std::invalid_argument naming the choices.
+enum class ColorMode { Plain, Heat, Regions, Deviation };
+// Parses "plain", "heat", "regions", "deviation"; throws std::invalid_argument naming the choices.
 [[nodiscard]] ColorMode parse_color_mode(const std::string& s);
 [[nodiscard]] const char* to_string(ColorMode m) noexcept;
+
+// Deviation colouring (docs/verification.md#deviation-colour): the colour of a vertex with
+// signed deviation `d_mm` from the design model (< 0 gouge: red, > 0 excess: blue, 0 within
+// the tolerance: grey-green). The mesh shader uses the same three colours.
+[[nodiscard]] std::array<std::uint8_t, 3> deviation_rgb(float d_mm) noexcept;
+// Fills `out` with the signed deviation [mm] of every vertex of `mesh` (the app computes it
+// from a design model, verify::vertex_deviation).
+using DeviationFn = std::function<void(const mesh::MeshBuffers& mesh, std::vector<float>& out)>;
 
 struct RenderOptions {
   ColorMode color = ColorMode::Plain;
@@ -33,6 +43,7 @@ struct RenderOptions {
   double section_mm = 0;
   bool section_flip = false;
   std::string notice;  // a warning line on the HUD (e.g. input that does not match the profile)
+  DeviationFn deviation;  // ColorMode::Deviation's per-vertex values; empty: that mode draws plain
   mesh::MeshOptions mesh;
   int max_regions_per_frame = 16;   // upper bound of the adaptive per-frame rebuild limit
   double mesh_budget_ms = 12.0;     // rebuild time per frame the limit adapts to [ms]
@@ -120,6 +131,7 @@ class Renderer {
   void draw_path();
   void draw_outline();
   void draw_hud(int w, int h);
+  void draw_alarms(int w, int h);
 
   RenderOptions opt_;
   MeshMirror mirror_;
@@ -134,6 +146,7 @@ class Renderer {
   std::uint64_t version_ = 0;
   int limit_ = 4;
   std::vector<std::uint32_t> upload_idx_;
+  std::vector<float> deviation_;  // a region's deviations for the upload (ColorMode::Deviation)
   std::vector<char> visible_;  // regions in the view frustum this frame
   FrameInfo last_;
 };

@@ -44,6 +44,15 @@ struct UiEvent {
   double wheel = 0;    // scroll steps (> 0: away from the user)
 };
 
+// A point the Measure tool picked (docs/ui.md): where the line of sight through the tap
+// first meets the material, from the render side's copy of the level polygons [mm].
+struct MeasurePoint {
+  double x_mm = 0, y_mm = 0, z_mm = 0;
+  double surface_z_mm = 0;  // top of the material on the vertical through (x, y)
+  double thickness_mm = 0;  // material on that vertical below the point
+  bool top_face = false;    // on a horizontal face (else a wall)
+};
+
 // A screen rectangle the UI occupies [px].
 struct UiRect {
   float x0 = 0, y0 = 0, x1 = 0, y1 = 0;

@@ -32,6 +32,10 @@ class EventRouter {
   int h_px_ = 1;
   double x_ = 0, y_ = 0;
   bool orbiting_ = false, panning_ = false, ui_owns_ = false;
+  // Measure mode: a left press on the 3D view is a tap until it moves further than a finger
+  // wobbles; released as a tap, it picks a point, otherwise it drags as usual.
+  bool tap_armed_ = false;
+  double tap_x_ = 0, tap_y_ = 0;
 };
 
 // Installs the bindings and polls events on the calling (main) thread until the window is

@@ -20,6 +20,9 @@ namespace lbr::mesh {
 // Binary PLY 1.0 (little-endian): vertices with x y z nx ny nz (float32) and move_id (float32:
 // the id of the move that last cut there, for colouring by time); faces as uchar-counted
 // lists of int32 indices. Regions are concatenated (vertex ids offset per region).
-[[nodiscard]] std::vector<std::uint8_t> to_binary_ply(std::span<const MeshBuffers> regions);
+// With `rgb` (3 bytes a vertex, the regions' vertices in order; empty: none), the vertices
+// also carry uchar red, green, blue (e.g. deviation colours, docs/formats.md#ply).
+[[nodiscard]] std::vector<std::uint8_t> to_binary_ply(std::span<const MeshBuffers> regions,
+                                                      std::span<const std::uint8_t> rgb = {});
 
 }  // namespace lbr::mesh

@@ -60,6 +60,11 @@ class Emulator {
 
   // Position and tool at time t [s] (clamped to [0, total]). Real-time safe; O(log n).
   void state_at(double t_s, AxisVector& axes, int& tool) const noexcept;
+  // Source line of the planned piece that holds time t [s] (a blend arc: the line of the
+  // move it leaves; t at a boundary: the piece that ends there); 0 before the first piece
+  // or without pieces. Real-time safe; O(log n). Reads only the plan, so another thread may
+  // call it while next() runs.
+  [[nodiscard]] int line_at(double t_s) const noexcept;
 
   // One planned piece of motion (exposed for tests and tools): a Hold (dwell, tool change), a
   // Line from `from` to `to`, or an Arc (blend) whose geometry is arcs()[arc].

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <span>
 #include <string>
@@ -67,6 +68,10 @@ class CollisionChecker {
   // moves[from] and of the clean moves are final and go to `events`.
   std::size_t check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves, std::size_t from,
                     std::size_t to, std::vector<Event>& events);
+  // The same for a live sample stream, which has no program to tell rapids by: moves[i] is
+  // a rapid when rapid[i] is non-zero (the caller's speed test, docs/verification.md#live).
+  std::size_t check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
+                    std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to, std::vector<Event>& events);
 
   [[nodiscard]] const CheckConfig& config() const noexcept { return config_; }
 
@@ -82,7 +87,8 @@ class CollisionChecker {
     Intrusion what;
   };
   // The findings of one move against `solid`; returns how many (0..3) were written.
-  int findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, Finding (&out)[3]);
+  // `rapid`: 1 / 0 the move is / is not a rapid, -1 the move index tells.
+  int findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, int rapid, Finding (&out)[3]);
   [[nodiscard]] Event event_of(const motion::TimedSweep& m, const Finding& f) const;
 
   CheckConfig config_;

@@ -70,6 +70,17 @@ struct DesignReport {
 void attribute_gouge(DesignReport& report, const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                      const MoveIndex& index);
 
+// Signed deviation of each vertex of a stock surface mesh (positions and unit outward
+// normals, 3 floats a vertex) from the design sections (docs/verification.md#deviation-colour):
+// < 0 gouge (the point half the tolerance outside the stock along the normal lies inside
+// the design, at least half the tolerance from its boundary: design material was cut), > 0
+// excess (the point half the tolerance inside the stock lies as far outside the design), 0
+// within the tolerance. The magnitude is that point's in-plane distance to the design
+// section's boundary on its level, plus half the tolerance [mm].
+void vertex_deviation(const std::vector<geom::Paths>& design, const geom::LbrSolid& solid,
+                      std::span<const float> positions, std::span<const float> normals, double tolerance_mm,
+                      std::vector<float>& out);
+
 // The report's levels as CSV (columns in docs/formats.md#deviation-csv).
 [[nodiscard]] std::string deviation_csv(const DesignReport& report);
 
