@@ -2,7 +2,9 @@
 // written as one outline. These cases check the region it removes three ways: against the
 // exact solid (helical bore, helical entry into a pocket), against the same moves cut one
 // by one (each move then gives its own convex section, nothing is joined), and against an
-// independent height-field reference for a sloped ball-end raster.
+// independent height-field reference for a sloped ball-end raster. Tilted moves (joined into
+// unions of their sections) against the same moves one by one, and a tilted swing beside
+// the material that builds no section at all.
 #include <algorithm>
 #include <cmath>
 
@@ -181,6 +183,76 @@ TEST(Joined, SlopedBallRasterMatchesAHeightFieldReference) {
   EXPECT_NEAR(v, ref, 0.0005 * ref) << "lbr " << v << " reference " << ref;
   RecordProperty("relative_error", std::to_string((v - ref) / ref));
   EXPECT_EQ(s.check_invariants(), "");
+}
+
+namespace {
+
+// Tool axis tilted by `a` [rad] about X (a table A axis seen from the workpiece).
+geom::Vec3 tilted(double a) { return {0.0, -std::sin(a), std::cos(a)}; }
+
+}  // namespace
+
+TEST(Joined, TiltedRasterCutInOneBatchEqualsTheMovesCutOneByOne) {
+  // Two passes of a ball Ø6 along X and back, the tilt going 0 -> 20° -> 0 and the tip
+  // following a bump: one batch (consecutive tilted sections joined into unions) against
+  // the same sweeps one by one (each sub-step its own convex section).
+  geom::LbrSolid joined(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  geom::LbrSolid single(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Ball, 6, 0, 18), kTol);
+  std::vector<geom::SweepRef> moves;
+  auto pose = [](double x, double y) {
+    const double a = 20.0 * test::kPi / 180.0 * std::sin(test::kPi * (x - 10.0) / 20.0);
+    return geom::Pose{{x, y, -3.0 + std::cos(x / 8.0)}, tilted(a)};
+  };
+  geom::MoveId id = 1;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double y = 18.0 + 0.5 * pass;
+    for (int i = 0; i < 40; ++i) {
+      const double x0 = pass == 0 ? 10.0 + 0.5 * i : 30.0 - 0.5 * i;
+      const double x1 = pass == 0 ? x0 + 0.5 : x0 - 0.5;
+      moves.push_back({&c, pose(x0, y), pose(x1, y), id++});
+    }
+    if (pass == 0) moves.push_back({&c, pose(30.0, y), pose(30.0, y + 0.5), id++});
+  }
+  const geom::SubtractStats st = joined.subtract(moves);
+  for (const auto& m : moves) single.subtract(std::span<const geom::SweepRef>(&m, 1));
+  EXPECT_GT(st.sections_joined, 5u * st.sections);  // the clips saw unions of up to 8 sections
+  const double perimeter = 2.0 * (20.0 + 7.0);
+  EXPECT_LT(max_level_area_gap(joined, single), 2.0 * perimeter * kTol);
+  EXPECT_GT(test::removed(joined), 250.0);
+  EXPECT_NEAR(test::removed(joined), test::removed(single), 2.0 * perimeter * kTol * 10.0);
+  EXPECT_EQ(joined.check_invariants(), "");
+}
+
+TEST(Joined, TiltedSweepBesideTheMaterialBuildsNoSection) {
+  // A radial Ø30 face mill swung a quarter turn about the axis of a Ø40 bar with its face
+  // on radius 30 (a lathe-c rotary rapid): never in the material, though its box meets the
+  // bar's box near 45°. No section is built and nothing is removed; the same swing with
+  // the face on radius 12 cuts.
+  geom::SolidSpec spec;
+  spec.shape = geom::SolidSpec::Shape::Cylinder;
+  spec.cylinder = {0.0, 0.0, 40.0, -60.0, 0.0};
+  spec.level_spacing_mm = 0.1;
+  spec.regions_x = spec.regions_y = 2;
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 30, 0, 10), kTol);
+  auto swing = [&](geom::LbrSolid& s, double radius) {
+    std::vector<geom::SweepRef> m;  // 16 chords of the arc, as the kinematics splits a C move
+    for (int k = 0; k < 16; ++k) {
+      const double a0 = 0.5 * test::kPi * k / 16, a1 = 0.5 * test::kPi * (k + 1) / 16;
+      const geom::Vec3 u0{std::cos(a0), std::sin(a0), 0}, u1{std::cos(a1), std::sin(a1), 0};
+      m.push_back({&c, {radius * u0 + geom::Vec3{0, 0, -38}, u0}, {radius * u1 + geom::Vec3{0, 0, -38}, u1},
+                   static_cast<geom::MoveId>(k + 1)});
+    }
+    return s.subtract(m);
+  };
+  geom::LbrSolid outside(spec), inside(spec);
+  const geom::SubtractStats so = swing(outside, 30.0);
+  EXPECT_EQ(so.sections, 0u);
+  EXPECT_EQ(test::removed(outside), 0.0);
+  const geom::SubtractStats si = swing(inside, 12.0);
+  EXPECT_GT(si.sections, 0u);
+  EXPECT_GT(test::removed(inside), 100.0);
+  EXPECT_EQ(inside.check_invariants(), "");
 }
 
 // ---- geom::tight_loop_end(): where a batch ends so that one turn of a tight loop is cut at a time ----

@@ -157,12 +157,13 @@ void plan_moves(SubtractShared& sh, double& zlo, double& zhi) {
     sh.sweeps.emplace_back(*s.shape, s.from, s.to);
     sh.sweep_id.push_back(s.id);
     const auto si = static_cast<std::uint32_t>(sh.sweeps.size() - 1);
-    const bool vertical = sh.sweeps.back().vertical();
-    if (vertical && run_open && merged[i - 1].shape == s.shape && merged[i - 1].to.tip == s.from.tip)
+    // A run: consecutive sweeps of one tool, each starting where the last ended (vertical
+    // ones are joined into outlines, tilted ones into unions: level_sections.cpp).
+    if (run_open && merged[i - 1].shape == s.shape && merged[i - 1].to.tip == s.from.tip)
       sh.runs.back().second = si + 1;
     else
-      sh.runs.emplace_back(si, si + 1);  // (a tilted move is a run of one: its section as it is)
-    run_open = vertical;
+      sh.runs.emplace_back(si, si + 1);
+    run_open = true;
     zlo = std::min(zlo, sh.sweeps.back().z_min());
     zhi = std::max(zhi, sh.sweeps.back().z_max());
   }

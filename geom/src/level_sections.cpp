@@ -11,6 +11,13 @@
 
 namespace lbr::geom::detail {
 
+namespace {
+// Consecutive tilted sections joined into one union (join_tilted()): large enough that a
+// group's outline has far fewer edges than its sections, small enough that the union's
+// own scan beams stay short.
+constexpr std::size_t kTiltedGroup = 8;
+}  // namespace
+
 // Builds offset `o` of the prepared batch. Offset vertices lie on radius r + tol/4 and
 // chords sag at most tol/2 inside it, so the boundary stays within ±tol/4 of the exact one.
 void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
@@ -37,7 +44,11 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
-  for (const auto& run : sh.runs) build_run_sections(zc, run, sh, ws, ls, stats);
+  // The material of this level before the batch (the cells' boxes): tilted sub-steps beside
+  // it are not built (Sweep::section()).
+  Rect material;
+  for (int r = 0; r < s_.regions(); ++r) material.add(s_.cell(r, level).bbox);
+  for (const auto& run : sh.runs) build_run_sections(zc, run, material, sh, ws, ls, stats);
   ls.chain.assign(ls.paths.size(), kNoChain);
   add_chain_sections(level, sh, ls);
   add_lathe_sections(zc, sh, ls);
@@ -101,8 +112,9 @@ void SubtractEngine::add_lathe_sections(double zc, const SubtractShared& sh, Lev
 // The sections of one run of sweeps on plane zc: consecutive moves whose sections share
 // their joint disk become one outline (chain_outline.hpp); the others are emitted one by
 // one, trimmed where the previous vertical section covers them (trim_covered()).
-void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
-                                  SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const {
+void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const Rect& material,
+                                        const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
+                                        SubtractStats& stats) const {
   Capsule prev_core;  // inside the last single vertical section of this run (trim_covered())
   auto push_boxes = [&](std::size_t before, MoveId id) {
     for (std::size_t k = before; k < ls.paths.size(); ++k) {
@@ -111,6 +123,12 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
       ls.all.add(ls.box.back());
     }
   };
+  // Tilted sections wait in ls.paths beyond ls.box (no boxes yet) until join_tilted().
+  MoveId tilted_id = 0;
+  auto flush_tilted = [&] {
+    if (ls.paths.size() > ls.box.size()) join_tilted(ls.box.size(), tilted_id, ws, ls, stats);
+    tilted_id = 0;
+  };
   std::uint32_t si = run.first;
   while (si < run.second) {
     const Sweep& sw = sh.sweeps[si];
@@ -118,6 +136,16 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
       ++si;
       continue;
     }
+    if (!sw.vertical()) {
+      const std::size_t before = ls.paths.size();
+      sw.section(zc, ls.paths, ws.scratch, &material);
+      trim_tilted(si, before, sh, ws, ls, stats);
+      if (ls.paths.size() > before) tilted_id = std::max(tilted_id, sh.sweep_id[si]);
+      if (ls.paths.size() - ls.box.size() >= kTiltedGroup) flush_tilted();
+      ++si;
+      continue;
+    }
+    flush_tilted();
     // Joined outline from si, when si and at least the next move share their joint disk.
     if (run.second - si >= 2) {
       // One angle grid along the run: the tool's full radius sets it. Even, so that a
@@ -146,7 +174,7 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
     sw.section(zc, ls.paths, ws.scratch);
     // Consecutive moves overlap: the vertices of this section inside the previous vertical
     // section's capsule add edges to the clip but remove nothing more (trim_covered()).
-    if (sw.vertical() && ls.paths.size() == before + 1) {
+    if (ls.paths.size() == before + 1) {
       if (prev_core.valid()) {
         const std::size_t vertices = ls.paths.back().size();
         if (!trim_covered(ls.paths.back(), prev_core, ws.trim_flags)) {
@@ -157,11 +185,38 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
         }
       }
       if (ws.scratch.core.valid()) prev_core = ws.scratch.core;
-    } else if (!sw.vertical()) {
-      trim_tilted(si, before, sh, ws, ls, stats);
     }
     push_boxes(before, sh.sweep_id[si]);
     ++si;
+  }
+  flush_tilted();
+}
+
+// The tilted sections ls.paths[begin..] (consecutive sub-steps and moves of one run, each
+// convex) become their union, with id `id` (the latest move among them). Fed to a clip as
+// separate polygons, neighbours that overlap put all their edges into every scan beam; a
+// group of kTiltedGroup sections along a path has the outline of about two sections. The
+// union is exact up to the rounding of its new vertices (the crossings of section edges)
+// to the unit grid, ±0.05 µm; its non-zero region is the union of the sections' regions.
+void SubtractEngine::join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls,
+                                 SubtractStats& stats) {
+  const std::size_t count = ls.paths.size() - begin;
+  if (count >= 2) {
+    ClipperLib::Clipper& u = ws.union_clipper;
+    u.Clear();
+    for (std::size_t k = begin; k < ls.paths.size(); ++k) {
+      u.AddPath(ls.paths[k], ClipperLib::ptSubject, true);
+      ws.scratch.spare.push_back(std::move(ls.paths[k]));
+    }
+    ls.paths.resize(begin);
+    u.Execute(ClipperLib::ctUnion, ws.union_out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+    for (Path& p : ws.union_out) ls.paths.push_back(std::move(p));
+    stats.sections_joined += count;
+  }
+  for (std::size_t k = begin; k < ls.paths.size(); ++k) {
+    ls.box.push_back(bounds_of(ls.paths[k]));
+    ls.id.push_back(id);
+    ls.all.add(ls.box.back());
   }
 }
 

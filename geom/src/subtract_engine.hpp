@@ -54,8 +54,9 @@ class SubtractEngine {
   // --- level_sections.cpp ---
   void build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                    SubtractStats& stats) const;
-  void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const SubtractShared& sh,
-                          SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
+  void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const Rect& material,
+                          const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
+  static void join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats);
   void trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
                    LevelSections& ls, SubtractStats& stats) const;
   static void add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls);

@@ -110,6 +110,8 @@ struct SubtractWorkspace {
   Path prev_tilted, tilted_next;              // the last tilted section of a level, untrimmed
   bool prev_tilted_valid = false;
   std::uint32_t prev_tilted_sweep = 0;
+  ClipperLib::Clipper union_clipper;          // joins a group of consecutive tilted sections
+  Paths union_out;
   std::vector<std::uint8_t> trim_flags;
   std::vector<int> source;          // per (level - lb, region): the level whose result it takes
   std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip

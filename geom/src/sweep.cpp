@@ -13,6 +13,7 @@
 #include "geom/sweep.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -95,28 +96,32 @@ int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
 // The convex hull of the tool's station circles at two poses (one sub-step of a move).
 // Its support in direction d is the larger of the two poses' supports, and at one pose the
 // support of station i is tip·d + h_i·(a·d) + r_i·|d⊥| (d⊥: d without its axis part). The
-// profile (h_i, r_i) is a concave chain, so that value is unimodal in i: a binary search on
-// its differences finds the best station in O(log stations) instead of a scan of all.
+// profile (h_i, r_i) is a concave chain, so the sign of its differences goes from + to
+// not +: the best station is the first whose step to the next does not increase the value.
+// Consecutive queries come from close directions, so it is found by walking from the last
+// query's station (one or two steps) rather than by a binary search; the result is the same.
 struct Hull3 {
   const CutterShape* shape;
   Pose pose[2];
+  mutable std::size_t last_station[2] = {0, 0};  // each pose's best station of the last query
   Vec3 support(const Vec3& d) const noexcept {
     const auto& st = shape->stations;
     double best = -INFINITY;
     Vec3 bp{};
-    for (const Pose& p : pose) {
+    const double dl = norm(d);
+    for (int k = 0; k < 2; ++k) {
+      const Pose& p = pose[k];
       const double along = dot(p.axis, d);
       const Vec3 perp = d - along * p.axis;
       const double pl = norm(perp);
-      const bool flat = pl <= 1e-15 * norm(d);
-      // First station whose step to the next does not increase the value.
-      std::size_t lo = 0, hi = st.size() - 1;
-      while (lo < hi) {
-        const std::size_t mid = (lo + hi) / 2;
-        const double step = (st[mid + 1].h - st[mid].h) * along + (flat ? 0.0 : (st[mid + 1].r - st[mid].r) * pl);
-        if (step > 0.0) lo = mid + 1;
-        else hi = mid;
-      }
+      const bool flat = pl <= 1e-15 * dl;
+      auto rises = [&](std::size_t i) {
+        return (st[i + 1].h - st[i].h) * along + (flat ? 0.0 : (st[i + 1].r - st[i].r) * pl) > 0.0;
+      };
+      std::size_t lo = last_station[k];
+      while (lo + 1 < st.size() && rises(lo)) ++lo;
+      while (lo > 0 && !rises(lo - 1)) --lo;
+      last_station[k] = lo;
       const double v = dot(p.tip, d) + st[lo].h * along + (flat ? 0.0 : st[lo].r * pl);
       if (v > best) {
         best = v;
@@ -127,25 +132,32 @@ struct Hull3 {
     return bp;
   }
   // Boundary point of the section of the hull by z = zc in in-plane direction (cos φ, sin φ),
-  // to about `eps` [mm]. The point is interpolated on the chord between the support points
-  // below and above the plane; the bisection on the tilt halves its distance to the
-  // boundary each step, so it stops once a step moves the point by less than eps/2 (the
-  // steps left would move it by about as much in all).
-  P2 section_point(double phi, double zc, double eps) const noexcept {
+  // to about `eps` [mm]: the support point of the section in that direction. The point is
+  // interpolated on the chord between the support points below and above the plane (inside
+  // the hull, so never outside the section); the bisection on the tilt t of the 3D
+  // direction (cos φ, sin φ, t) halves its distance to the boundary each step, so it stops
+  // once a step moves the point by less than eps/2 (the steps left would move it by about
+  // as much in all). The search starts from [t_lo, t_hi] (a neighbouring direction's
+  // bracket: the tilt changes little between close directions), widened until it brackets
+  // the plane; `t_lo`/`t_hi` return the final bracket. At least `min_steps` + 1 steps: a
+  // wide start bracket can give a first step that happens to move little.
+  P2 section_point(double phi, double zc, double eps, double& t_lo, double& t_hi, int min_steps) const noexcept {
     const double ux = std::cos(phi), uy = std::sin(phi);
     auto sup = [&](double t) { return support(Vec3{ux, uy, t}); };
-    double tlo = -1.0, thi = 1.0;
+    double tlo = t_lo, thi = t_hi;
     Vec3 plo = sup(tlo), phi_ = sup(thi);
     for (int i = 0; i < 80 && plo.z > zc; ++i) {
+      const double w = thi - tlo;
       thi = tlo;
       phi_ = plo;
-      tlo *= 2.0;
+      tlo -= 2.0 * w + 1e-9;
       plo = sup(tlo);
     }
     for (int i = 0; i < 80 && phi_.z < zc; ++i) {
+      const double w = thi - tlo;
       tlo = thi;
       plo = phi_;
-      thi *= 2.0;
+      thi += 2.0 * w + 1e-9;
       phi_ = sup(thi);
     }
     auto interpolate = [&] {
@@ -169,8 +181,10 @@ struct Hull3 {
       const P2 now = interpolate();
       const double dx = now.x - last.x, dy = now.y - last.y;
       last = now;
-      if (i >= 4 && dx * dx + dy * dy <= stop2) break;
+      if (i >= min_steps && dx * dx + dy * dy <= stop2) break;
     }
+    t_lo = tlo;
+    t_hi = thi;
     return last;
   }
 };
@@ -229,10 +243,10 @@ Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcep
   }
 }
 
-std::size_t Sweep::section(double z_mm, Paths& out, SectionScratch& scratch) const {
+std::size_t Sweep::section(double z_mm, Paths& out, SectionScratch& scratch, const Rect* material) const {
   scratch.core = Capsule{};
   if (z_mm < box_.lo.z || z_mm > box_.hi.z) return 0;
-  return vertical_ ? section_vertical(z_mm, out, scratch) : section_general(z_mm, out, scratch);
+  return vertical_ ? section_vertical(z_mm, out, scratch) : section_general(z_mm, out, scratch, material);
 }
 
 bool Sweep::section_disks(double zc, SectionScratch& sc) const {
@@ -640,9 +654,109 @@ const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {
   return c;
 }
 
-std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) const {
+namespace {
+
+// The boundary of the section of `hull` on z = zc, as support points in angular order
+// (counter-clockwise) appended to sc.pts. Between the support points a and b of directions
+// φa < φb the boundary lies in the triangle of the chord ab and the two support lines
+// (convexity), whose height over the chord is at most |ab|/2 · tan((φb − φa)/2) (base
+// angles summing to φb − φa). An interval is split at its middle direction until that
+// bound is within tol/2, so every vertex is evaluated once and kept; a middle point on the
+// chord (within the point accuracy) proves the boundary straight there (the support line
+// through it holds a and b) and ends the split as well.
+void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc) {
+  constexpr double kPointEps = 0.05;  // boundary points to tol/20
+  constexpr int kStart = 16;
+  constexpr int kMaxPoints = 8192;
+  constexpr int kWarmSteps = 1;  // a middle direction starts from its neighbours' brackets
+  const double eps = kPointEps * tol;
+  struct Iv {
+    double pa, pb;
+    P2 a, b;
+    double ta_lo, ta_hi, tb_lo, tb_hi;
+    int depth;
+  };
+  // tan(Δφ/2) of an interval at each depth (Δφ = 2π/kStart/2^depth); beyond the table, the
+  // last entry bounds it.
+  constexpr int kDepths = 41;
+  static const std::array<double, kDepths> tan_half = [] {
+    std::array<double, kDepths> t{};
+    for (int d = 0; d < kDepths; ++d) t[static_cast<std::size_t>(d)] = std::tan(std::numbers::pi / kStart / std::ldexp(1.0, d));
+    return t;
+  }();
+  sc.dirs.clear();
+  double tlo = -1.0, thi = 1.0;
+  for (int i = 0; i < kStart; ++i) {
+    const double phi = 2.0 * std::numbers::pi * i / kStart;
+    const P2 p = hull.section_point(phi, zc, eps, tlo, thi, 4);
+    sc.dirs.push_back({phi, p, tlo, thi});
+  }
+  sc.pts.clear();
+  for (int i = 0; i < kStart; ++i) {
+    const int j = (i + 1) % kStart;
+    Iv stack[64];
+    int sp = 0;
+    stack[sp++] = {sc.dirs[i].phi, sc.dirs[i].phi + 2.0 * std::numbers::pi / kStart, sc.dirs[i].p, sc.dirs[j].p,
+                   sc.dirs[i].t_lo, sc.dirs[i].t_hi, sc.dirs[j].t_lo, sc.dirs[j].t_hi, 0};
+    while (sp > 0) {
+      const Iv iv = stack[--sp];
+      const double dx = iv.b.x - iv.a.x, dy = iv.b.y - iv.a.y;
+      const double bound = 0.5 * tan_half[static_cast<std::size_t>(std::min(iv.depth, kDepths - 1))];  // |ab|/2 · tan(Δφ/2) / |ab|
+      if (iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
+          bound * bound * (dx * dx + dy * dy) <= 0.25 * tol * tol) {
+        sc.pts.push_back(iv.a);
+        continue;
+      }
+      const double pm = 0.5 * (iv.pa + iv.pb);
+      double mlo = std::min(iv.ta_lo, iv.tb_lo), mhi = std::max(iv.ta_hi, iv.tb_hi);
+      const P2 m = hull.section_point(pm, zc, eps, mlo, mhi, kWarmSteps);
+      if (dist_to_line(m, iv.a, iv.b) <= eps) {
+        sc.pts.push_back(iv.a);
+        sc.pts.push_back(m);
+        continue;
+      }
+      stack[sp++] = {pm, iv.pb, m, iv.b, mlo, mhi, iv.tb_lo, iv.tb_hi, iv.depth + 1};  // right half last
+      stack[sp++] = {iv.pa, pm, iv.a, m, iv.ta_lo, iv.ta_hi, mlo, mhi, iv.depth + 1};
+    }
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// True when the sub-step's hull (circles c[0..n)) certainly misses the material box `m`
+// [units] in XY: their boxes are apart, or the horizontal direction u from the box's
+// centre to the circles' centroid separates them (the hull's least u·p, one support query,
+// beyond the box's greatest). The section on any plane lies in the hull, so it would
+// remove nothing.
+bool beside_material(const Hull3& hull, const Circle* c, int n, const Rect& m) noexcept {
+  if (m.empty()) return true;
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY, cx = 0.0, cy = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double ex = c[i].r * std::sqrt(std::max(0.0, 1.0 - c[i].n.x * c[i].n.x));
+    const double ey = c[i].r * std::sqrt(std::max(0.0, 1.0 - c[i].n.y * c[i].n.y));
+    x0 = std::min(x0, c[i].c.x - ex);
+    x1 = std::max(x1, c[i].c.x + ex);
+    y0 = std::min(y0, c[i].c.y - ey);
+    y1 = std::max(y1, c[i].c.y + ey);
+    cx += c[i].c.x / n;
+    cy += c[i].c.y / n;
+  }
+  const double mx0 = to_mm(m.x0), mx1 = to_mm(m.x1), my0 = to_mm(m.y0), my1 = to_mm(m.y1);
+  if (x1 < mx0 || x0 > mx1 || y1 < my0 || y0 > my1) return true;
+  const double ux = cx - 0.5 * (mx0 + mx1), uy = cy - 0.5 * (my0 + my1), ul = std::hypot(ux, uy);
+  if (!(ul > 0.0)) return false;
+  const Vec3 u{ux / ul, uy / ul, 0.0};
+  const double hull_min = dot(hull.support(Vec3{-u.x, -u.y, 0.0}), u);
+  const double box_max = std::max(u.x * mx0, u.x * mx1) + std::max(u.y * my0, u.y * my1);
+  return hull_min > box_max;
+}
+
+}  // namespace
+
+std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc, const Rect* material) const {
   const CutterShape& s = *shape_;
-  const double tol = s.chord_tol_mm;
   const int ns = static_cast<int>(s.stations.size());
   constexpr int kMaxStations = 512;
   Circle circles[2 * kMaxStations];
@@ -665,43 +779,8 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc) co
     }
     if (zc < zlo || zc > zhi) continue;
     const Hull3 hull{&s, {pa, b}};
-    // Boundary points to 1/20 of the chord tolerance: the refinement below splits where a
-    // point lies farther than tol/2 from its chord.
-    constexpr double kPointEps = 0.05;
-    // Adaptive refinement in angle: start with 16 directions, split an interval while the
-    // boundary point at its middle lies farther than tol/2 from the chord.
-    sc.dirs.clear();
-    constexpr int kStart = 16;
-    constexpr int kMaxPoints = 8192;
-    for (int i = 0; i <= kStart; ++i) {
-      const double phi = 2.0 * std::numbers::pi * i / kStart;
-      sc.dirs.push_back({phi, i == kStart ? sc.dirs.front().p : hull.section_point(phi, zc, kPointEps * tol)});
-    }
-    sc.pts.clear();
-    // Depth-first refinement using `hull` storage as a stack of intervals (reused buffer).
-    for (int i = 0; i < kStart; ++i) {
-      struct Iv {
-        double pa, pb;
-        P2 a, b;
-        int depth;
-      };
-      Iv stack[64];
-      int sp = 0;
-      stack[sp++] = {sc.dirs[i].phi, sc.dirs[i + 1].phi, sc.dirs[i].p, sc.dirs[i + 1].p, 0};
-      while (sp > 0) {
-        const Iv iv = stack[--sp];
-        const double pm = 0.5 * (iv.pa + iv.pb);
-        const P2 m = hull.section_point(pm, zc, kPointEps * tol);
-        if (iv.depth < 40 && static_cast<int>(sc.pts.size()) < kMaxPoints && sp + 2 <= 64 &&
-            dist_to_line(m, iv.a, iv.b) > 0.5 * tol) {
-          stack[sp++] = {pm, iv.pb, m, iv.b, iv.depth + 1};  // right half processed last
-          stack[sp++] = {iv.pa, pm, iv.a, m, iv.depth + 1};
-        } else {
-          sc.pts.push_back(iv.a);
-          sc.pts.push_back(m);
-        }
-      }
-    }
+    if (material != nullptr && beside_material(hull, circles, nc, *material)) continue;
+    refine_section(hull, zc, s.chord_tol_mm, sc);
     convex_hull(sc.pts, sc.hull);
     emitted += emit(sc.hull, out, sc.spare);
   }

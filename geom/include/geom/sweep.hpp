@@ -51,6 +51,7 @@ struct SectionScratch {
   struct Dir {
     double phi;
     P2 p;
+    double t_lo, t_hi;  // the bracket of the 3D direction's tilt that found p (section_general)
   };
   std::vector<Dir> dirs;
   // Set by each vertical section: a capsule inside the polygon just emitted (invalid when
@@ -109,7 +110,11 @@ class Sweep {
   // Appends the section on plane z = z_mm as convex polygons (counter-clockwise, kernel
   // units) to out; returns how many were appended. `scratch` is reused between calls to
   // avoid allocation once it has grown. Real-time safe once the buffers have grown.
-  std::size_t section(double z_mm, Paths& out, SectionScratch& scratch) const;
+  // `material`, when given, bounds what the section may remove on this plane (the box of
+  // the material there, kernel units): a tilted sub-step whose swept hull lies wholly beside
+  // it (its box, or one horizontal direction that separates the two) is not built, as its
+  // section would remove nothing.
+  std::size_t section(double z_mm, Paths& out, SectionScratch& scratch, const Rect* material = nullptr) const;
 
   // Number of polygon vertices used for a full circle of radius r [mm] at the shape's chord
   // tolerance (at least 8, at most 4096).
@@ -126,7 +131,7 @@ class Sweep {
 
  private:
   std::size_t section_vertical(double z_mm, Paths& out, SectionScratch& scratch) const;
-  std::size_t section_general(double z_mm, Paths& out, SectionScratch& scratch) const;
+  std::size_t section_general(double z_mm, Paths& out, SectionScratch& scratch, const Rect* material) const;
   // The hull of sc.disks on the n-grid in sc.hull (with hull_role, hull_grid); ends_only keeps
   // only the first and last vertex of each run of directions one end disk wins.
   void ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<SectionScratch::P2>& uc, bool ends_only) const;
