@@ -18,6 +18,7 @@
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "app/view.hpp"
+#include "stream_test_util.hpp"
 #include "gfx/exchange.hpp"
 #include "gfx/ui.hpp"
 
@@ -125,17 +126,6 @@ double distance_to_segment_mm(const geom::Vec3& p, const geom::Vec3& a, const ge
 }
 
 // The streamer's sweeps with this line, starting from the untouched stock (a reference solid).
-double removed_by_sweeps_mm3(const StreamCase& run, const app::PathStreamer& s, double upto_s) {
-  geom::LbrSolid ref(app::stream_solid_spec(run.profile, run.channels));
-  std::vector<geom::SweepRef> batch;
-  for (const motion::TimedSweep& t : s.sweeps()) {
-    if (t.t_s > upto_s) break;
-    batch.push_back(t.ref);
-  }
-  ref.subtract(batch);
-  return ref.initial_volume_mm3() - ref.volume_mm3();
-}
-
 }  // namespace
 
 // The program panel's line (issue 17): every sampled sweep carries the source line of the
@@ -213,7 +203,7 @@ TEST(ViewAnimate, JumpsToATimeOrALineRemoveWhatTheSweepsUpToThereRemove) {
   ASSERT_TRUE(wait_until([&] { return streamer.position_s() == t; }));
   const double removed_t = solid.initial_volume_mm3() - solid.volume_mm3();
   EXPECT_GT(removed_t, 1000.0);
-  EXPECT_NEAR(removed_t, removed_by_sweeps_mm3(run, streamer, t), 5e-5 * removed_t);
+  EXPECT_NEAR(removed_t, test::removed_by_sweeps_mm3(app::stream_solid_spec(run.profile, run.channels), streamer, t), 5e-5 * removed_t);
   // A line: the end of its motion (the last sweep with that line; the program has no loops).
   const int line = streamer.sweeps()[streamer.sweeps().size() / 4].line;
   double end_s = 0;
@@ -223,7 +213,7 @@ TEST(ViewAnimate, JumpsToATimeOrALineRemoveWhatTheSweepsUpToThereRemove) {
   ASSERT_TRUE(wait_until([&] { return streamer.position_s() == end_s; }));
   EXPECT_EQ(streamer.program_line(), line);
   const double removed_line = solid.initial_volume_mm3() - solid.volume_mm3();
-  EXPECT_NEAR(removed_line, removed_by_sweeps_mm3(run, streamer, end_s), 5e-5 * removed_line);
+  EXPECT_NEAR(removed_line, test::removed_by_sweeps_mm3(app::stream_solid_spec(run.profile, run.channels), streamer, end_s), 5e-5 * removed_line);
   EXPECT_LT(removed_line, removed_t);
   streamer.stop();
   drain.store(false);

@@ -21,6 +21,7 @@
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "app/view.hpp"
+#include "stream_test_util.hpp"
 #include "gfx/render_thread.hpp"
 #include "gfx/renderer.hpp"
 #include "gfx/viewer.hpp"
@@ -258,17 +259,6 @@ TEST_F(GfxUi, PauseStopsTheRemovedVolumeFromGrowing) {
 }
 
 // The same sweeps from the untouched stock up to `upto_s`, on a fresh solid [mm3 removed].
-double removed_by_sweeps_mm3(const geom::SolidSpec& spec, const app::PathStreamer& s, double upto_s) {
-  geom::LbrSolid ref(spec);
-  std::vector<geom::SweepRef> batch;
-  for (const motion::TimedSweep& t : s.sweeps()) {
-    if (t.t_s > upto_s) break;
-    batch.push_back(t.ref);
-  }
-  ref.subtract(batch);
-  return ref.initial_volume_mm3() - ref.volume_mm3();
-}
-
 // Program panel and time slider (issue 17) on cam-pocket.ngc, paused: touching the time
 // slider at 40 % re-simulates to about 40 % of the machining time (the removed volume is that
 // of the sweeps up to there), the panel scrolls to the line being cut and highlights it;
@@ -298,7 +288,7 @@ TEST_F(GfxUi, TimeSliderAndProgramLinesJumpTheSimulation) {
   EXPECT_NEAR(t / streamer.duration_s(), 0.4, 0.05);
   const double removed_t = solid.initial_volume_mm3() - solid.volume_mm3();
   EXPECT_GT(removed_t, 1000.0);
-  EXPECT_NEAR(removed_t, removed_by_sweeps_mm3(spec, streamer, t), 5e-5 * removed_t);
+  EXPECT_NEAR(removed_t, test::removed_by_sweeps_mm3(spec, streamer, t), 5e-5 * removed_t);
   // The current line is shown, highlighted: its row differs from the row below.
   const std::int64_t cur = streamer.program_line();
   ASSERT_GT(cur, 0);
@@ -327,7 +317,7 @@ TEST_F(GfxUi, TimeSliderAndProgramLinesJumpTheSimulation) {
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   const double removed_line = solid.initial_volume_mm3() - solid.volume_mm3();
   EXPECT_GT(removed_line, removed_t);
-  EXPECT_NEAR(removed_line, removed_by_sweeps_mm3(spec, streamer, end_s), 5e-5 * removed_line);
+  EXPECT_NEAR(removed_line, test::removed_by_sweeps_mm3(spec, streamer, end_s), 5e-5 * removed_line);
   streamer.stop();
 }
 
