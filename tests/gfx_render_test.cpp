@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <cstdlib>
 #include <memory>
 #include <optional>
@@ -260,6 +264,47 @@ TEST_F(GfxRender, RenderThreadRunsAtItsRateWhileCutsArrive) {
   RecordProperty("period_p50_ms", std::to_string(gfx::PacingReport::percentile(rep.period_ms, 0.5)));
   RecordProperty("period_p99_ms", std::to_string(gfx::PacingReport::percentile(rep.period_ms, 0.99)));
   RecordProperty("refused_publishes", std::to_string(refused));
+}
+
+// With screenshots on, stop() writes one more PNG of the state published last, however few
+// frames were drawn (a loaded machine drew 30 frames of a 3 s run, and the periodic PNGs
+// missed the final alarm): here no periodic PNG falls after the cut, so only the final
+// one can show it.
+TEST_F(GfxRender, StopWritesAFinalScreenshotOfTheLastPublishedState) {
+  geom::LbrSolid s = stock();
+  s.clear_dirty();
+  gfx::SolidExchange ex;
+  gfx::RenderThreadConfig cfg;
+  cfg.rate_hz = 30;
+  cfg.render = test_options();
+  cfg.width = 160;
+  cfg.height = 120;
+  cfg.screenshot_every = 1000000;  // frame 0 only
+  const std::string prefix = ::testing::TempDir() + "final-shot-";
+  cfg.screenshot_prefix = prefix;
+  gfx::RenderThread rt(*win_, ex, s, cfg);
+  rt.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const geom::CutterShape t6 = flat6();
+  const auto path = pocket_path();
+  for (std::size_t i = 1; i < path.size(); ++i)
+    cut(s, t6, {path[i - 1], {0, 0, 1}}, {path[i], {0, 0, 1}}, static_cast<geom::MoveId>(i));
+  ASSERT_TRUE(ex.publish(s, {}, static_cast<geom::MoveId>(path.size() - 1), {}));
+  rt.stop();
+  const gfx::PacingReport& rep = rt.report();
+  ASSERT_TRUE(rep.error.empty()) << rep.error;
+  ASSERT_GE(rep.frames, 2u);
+  EXPECT_EQ(rep.screenshots, 2u);
+  auto bytes = [](const std::string& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  char last[32];
+  std::snprintf(last, sizeof last, "%06llu.png", static_cast<unsigned long long>(rep.frames - 1));
+  const std::string first_png = bytes(prefix + "000000.png"), final_png = bytes(prefix + last);
+  ASSERT_FALSE(first_png.empty());
+  ASSERT_FALSE(final_png.empty()) << prefix + last;
+  EXPECT_NE(first_png, final_png);  // the pocket is in the final PNG only
 }
 
 // Issue 19 item 3: a groove along the front face y = 0 that stops at x = 72 (flat Ø10, so

@@ -742,8 +742,8 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_flag("--hidden", ro.hidden, "Render without a visible window (with --screenshot-every)");
   run->add_flag("--no-ui", ro.no_ui, "Hide the operator UI (status bar, view controls); the text HUD instead");
   run->add_flag("--kiosk", ro.kiosk, "Full screen without decorations; quitting asks for a confirmation");
-  run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames (needs a display; "
-                  "headless: xvfb-run -a)")->check(CLI::Range(0, 1000000));
+  run->add_option("--screenshot-every", ro.screenshot_every, "Write a PNG every N render frames, and one of the final state "
+                  "when the run ends (needs a display; headless: xvfb-run -a)")->check(CLI::Range(0, 1000000));
   run->add_option("--screenshot-prefix", ro.screenshot_prefix,
                   "Screenshot file prefix (PREFIX000123.png); default: OUT/frame- in the --out directory");
   run->add_flag("--no-tool", ro.no_tool, "Do not draw the tool (key K toggles it)");

@@ -173,9 +173,10 @@ void RenderThread::apply_ui(const detail::UiActions& act) {
 }
 
 // The frame into the window (with the UI over it) or offscreen, and the optional PNG.
-FrameInfo RenderThread::draw(Renderer& ren, const Camera& cam, int w, int h, double dt_s) {
+FrameInfo RenderThread::draw(Renderer& ren, const Camera& cam, int w, int h, double dt_s, bool force_shot) {
   FrameInfo fi;
-  const bool shot = cfg_.screenshot_every > 0 && report_.frames % static_cast<std::uint64_t>(cfg_.screenshot_every) == 0;
+  const bool shot = cfg_.screenshot_every > 0 &&
+                    (force_shot || report_.frames % static_cast<std::uint64_t>(cfg_.screenshot_every) == 0);
   // Hidden windows draw offscreen (their default framebuffer may not be backed).
   if (shot) {
     const Image img = ren.render_offscreen(cam, w, h, false, &fi);
@@ -205,6 +206,21 @@ FrameInfo RenderThread::draw(Renderer& ren, const Camera& cam, int w, int h, dou
     glFinish();  // the frame's work is done (and measured) within its own period
   }
   return fi;
+}
+
+// With screenshots on, the state at stop() as one more PNG (numbered after the last frame),
+// so that the last file shows the end of the run however many frames a slow machine drew.
+void RenderThread::final_shot(Renderer& ren, Snapshot& snap) {
+  if (cfg_.screenshot_every <= 0) return;
+  if (ex_.take(snap)) {
+    ren.receive(snap);
+    ++report_.snapshots;
+  }
+  Camera cam;
+  int w = 0, h = 0;
+  sync(ren, cam, w, h);
+  (void)draw(ren, cam, w, h, 1.0 / cfg_.rate_hz, true);
+  ++report_.frames;
 }
 
 // Taps of the Measure tool, against the mirror solid as this frame shows it (the levels of
@@ -313,6 +329,7 @@ void RenderThread::loop() {
         std::this_thread::sleep_until(next);
       }
     }
+    if (stop_.load(std::memory_order_acquire)) final_shot(ren, snap);
     ui_ = nullptr;
   } catch (const std::exception& e) {
     ui_ = nullptr;

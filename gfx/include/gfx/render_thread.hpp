@@ -40,7 +40,7 @@ struct RenderThreadConfig {
   StandardView view = StandardView::Iso;
   bool ortho = false;
   int width = 1280, height = 800;    // drawing size: the window's framebuffer size initially
-  int screenshot_every = 0;          // 0: none; N: a PNG every N frames
+  int screenshot_every = 0;          // 0: none; N: a PNG every N frames, and one of the final state at stop()
   std::string screenshot_prefix = "frame-";  // files PREFIX000123.png
   std::size_t max_frames = 0;        // 0: until stop(); otherwise stop by itself after N frames
   UiConfig ui;                       // the operator UI (visible windows only; replaces the HUD)
@@ -115,7 +115,8 @@ class RenderThread {
   // Steps of one frame of loop().
   void sync(Renderer& ren, Camera& cam, int& w, int& h);
   void apply_ui(const detail::UiActions& act);
-  FrameInfo draw(Renderer& ren, const Camera& cam, int w, int h, double dt_s);
+  FrameInfo draw(Renderer& ren, const Camera& cam, int w, int h, double dt_s, bool force_shot = false);
+  void final_shot(Renderer& ren, Snapshot& snap);
   void serve_capture(int w, int h);
   void serve_picks(Renderer& ren, const Camera& cam, int w, int h);
 
