@@ -122,6 +122,27 @@ TEST(CollisionChecks, AForgottenG43PutsShankAndHolderIntoTheStockAtTheRightLine)
   EXPECT_TRUE(good.events.empty());
 }
 
+// A raster that forgets G43: every move drags the shank through the stock. The moves that
+// continue a run of the same findings stay in their batch, so the run costs about as many
+// cell clips as the program without checks (one batch per move cost 20 to 30 times as many),
+// and it is still one shank event from its first line.
+TEST(CollisionChecks, ARunOfOffendingMovesCostsAFewBatchesNotOneEach) {
+  std::string raster = "G0 X10 Y10 Z5\nG1 Z-2 F300\n";
+  for (int k = 0; k < 30; ++k) raster += "G1 X" + std::to_string(k % 2 == 0 ? 90 : 10) + " F600\nG1 Y" + std::to_string(12 + 2 * k) + "\n";
+  raster += "G0 Z20\nM2\n";
+  const std::string bad = "G21 G90 G17\nT1 M6 S1000 M3\n" + raster;
+  const app::BatchResult checked = run(bad);
+  app::Profile off = app::default_profile();
+  off.checks.enabled = false;
+  const app::BatchResult unchecked = run(off, bad);
+  ASSERT_EQ(count_kind(checked.events, verify::EventKind::ShankInMaterial), 1u);
+  const verify::Event* shank = first_of(checked.events, verify::EventKind::ShankInMaterial);
+  EXPECT_EQ(shank->line, 3);  // G0 Z5 puts the tip at Z-55: the shank (from Z-25) is in the box
+  EXPECT_GE(shank->moves, 60u);
+  EXPECT_LE(checked.batches, unchecked.batches + 4) << "unchecked: " << unchecked.batches;
+  EXPECT_NEAR(checked.removed_volume_mm3, unchecked.removed_volume_mm3, 1e-6 * unchecked.removed_volume_mm3);
+}
+
 TEST(CollisionChecks, TheBundledDemoIsClean) {
   app::Profile p = app::default_profile();
   p.threads = 1;

@@ -70,6 +70,7 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   };
   std::size_t done_moves = 0;
   const geom::ParallelSubtractor::BatchDone done = [&](const geom::SubtractStats&) {
+    ++r.batches;
     if (checker != nullptr || ends.empty()) {
       done_moves = begin;
     } else {  // the pool may already have pulled the next batch

@@ -158,6 +158,7 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
   j["moves"] = r.moves;
   j["sections"] = r.stats.sections;
   j["cells_clipped"] = r.stats.cells_clipped;
+  j["kernel_batches"] = r.batches;
   j["cells_changed"] = r.stats.cells_changed;
   j["cells_reused"] = r.stats.cells_reused;
   j["sections_trimmed"] = r.stats.sections_trimmed;

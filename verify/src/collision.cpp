@@ -86,7 +86,8 @@ int CollisionChecker::segment_findings(const geom::LbrSolid& solid, const motion
   const bool too_fast =
       seg != nullptr && seg->kind == nc::SegmentKind::Feed && feed_limit > 0.0 && seg->feed_mm_per_min > feed_limit;
   if (rapid || spindle_off || too_fast) {
-    const Intrusion in = probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm);
+    const Intrusion in =
+        probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm, contact_only_);
     if (in.deep_mm3 > 0.0) {
       if (rapid) out[n++] = {EventKind::RapidIntoMaterial, in};
       if (spindle_off) out[n++] = {EventKind::SpindleOff, in, seg->spindle_s};
@@ -101,19 +102,20 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
   if (!p.centre_cutting) {
     const double angle = descent_deg(m.ref.from, m.ref.to);
     if (angle > config_.max_ramp_angle_deg) {
-      const Intrusion in = probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to), config_.tolerance_mm);
+      const Intrusion in =
+          probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to), config_.tolerance_mm, contact_only_);
       if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
     }
   }
   if (p.has_shank) {
     const Intrusion in =
         probe_.measure(solid, geom::Sweep(p.shank, raised(m.ref.from, p.shank_from_mm), raised(m.ref.to, p.shank_from_mm)),
-                       config_.tolerance_mm);
+                       config_.tolerance_mm, contact_only_);
     if (in.deep_mm3 > 0.0) out[n++] = {EventKind::ShankInMaterial, in};
   }
   const Intrusion in =
       probe_.measure(solid, geom::Sweep(p.holder, raised(m.ref.from, p.holder_from_mm), raised(m.ref.to, p.holder_from_mm)),
-                     config_.tolerance_mm);
+                     config_.tolerance_mm, contact_only_);
   if (in.deep_mm3 > 0.0) out[n++] = {EventKind::HolderInMaterial, in};
   return n;
 }
@@ -140,19 +142,40 @@ Event CollisionChecker::event_of(const motion::TimedSweep& m, const Finding& f) 
 
 std::size_t CollisionChecker::check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                                     std::size_t from, std::size_t to, std::vector<Event>& events) {
-  return check(solid, moves, {}, from, to, events);
+  return check_moves(solid, moves, {}, from, to, events, true);
 }
 
 std::size_t CollisionChecker::check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                                     std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to,
                                     std::vector<Event>& events) {
+  return check_moves(solid, moves, rapid, from, to, events, false);
+}
+
+std::size_t CollisionChecker::check_moves(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
+                                          std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to,
+                                          std::vector<Event>& events, bool runs) {
   if (!config_.enabled) return to;
   Findings found;
+  unsigned before = 0;  // the kinds the move before raised (bit per EventKind), 0: clean
   for (std::size_t i = from; i < to; ++i) {
+    // After a move with findings, the next is first tested for contact only: if it continues
+    // the run (the same kinds), it extends the run's events without adding volume or depth.
+    contact_only_ = runs && i > from && before != 0;
     const int n = findings_of(solid, moves[i], rapid.empty() ? -1 : (rapid[i] != 0 ? 1 : 0), found);
-    if (n > 0 && i > from) return i;
-    for (int k = 0; k < n; ++k) add_event(events, event_of(moves[i], found[k]));
+    unsigned kinds = 0;
+    for (int k = 0; k < n; ++k) kinds |= 1u << static_cast<unsigned>(found[k].kind);
+    // A move that starts a run of findings is checked again against the stock of its moment.
+    if (n > 0 && i > from && (!runs || kinds != before)) {
+      contact_only_ = false;
+      return i;
+    }
+    before = kinds;
+    for (int k = 0; k < n; ++k) {
+      if (contact_only_) found[k].what.volume_mm3 = found[k].what.depth_mm = 0.0;
+      add_event(events, event_of(moves[i], found[k]));
+    }
   }
+  contact_only_ = false;
   return to;
 }
 

@@ -112,7 +112,8 @@ int IntrusionProbe::top_material_level(const geom::LbrSolid& solid, int from) co
   return -1;
 }
 
-Intrusion IntrusionProbe::measure(const geom::LbrSolid& solid, const geom::Sweep& sweep, double margin_mm) {
+Intrusion IntrusionProbe::measure(const geom::LbrSolid& solid, const geom::Sweep& sweep, double margin_mm,
+                                  bool contact_only) {
   Intrusion out;
   const geom::Box3& b = sweep.bounds();
   const double z_lo = std::max(b.lo.z, solid.z_bottom_mm());
@@ -160,6 +161,7 @@ Intrusion IntrusionProbe::measure(const geom::LbrSolid& solid, const geom::Sweep
     hit_lo = std::min(hit_lo, bottom);
     hit_hi = std::max(hit_hi, top);
     out.volume_mm3 += level_mm3;
+    if (contact_only && out.deep_mm3 > 0.0) break;
   }
   if (out.volume_mm3 <= 0.0) return out;
   out.depth_mm = hit_hi - hit_lo;

@@ -30,6 +30,7 @@ struct BatchResult {
   std::vector<verify::Event> events;  // collision and process checks (verify/), in move order
   std::optional<verify::DesignReport> design;  // profile.design.stl_path set: the final stock against it
   std::vector<geom::Paths> design_sections{};   // the sliced design (--design), for deviation colours
+  std::uint64_t batches = 0;    // kernel calls (batches of moves subtracted at once)
 };
 
 // Progress callback: fraction done in [0, 1].

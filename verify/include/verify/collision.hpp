@@ -76,13 +76,22 @@ class CollisionChecker {
   CollisionChecker(const CheckConfig& config, const motion::ToolTable& tools, const MoveIndex& index);
 
   // Checks moves [from, to) against `solid`, the stock just before moves[from]. Returns the
-  // index of the first move after `from` that meets material (its check must be repeated
-  // once the moves before it are subtracted), or `to` when there is none. Findings of
-  // moves[from] and of the clean moves are final and go to `events`.
+  // index of the first move after `from` that starts a run of findings (it meets material
+  // and the move before it raised other kinds or none; its check must be repeated once the
+  // moves before it are subtracted), or `to` when there is none. Findings of moves[from],
+  // of the clean moves and of the moves that continue a run (the same kinds as the move
+  // before them) are final and go to `events`: a run of offending moves is measured against
+  // the stock at the start of its batch, so a program that forgets G43 costs a few batches,
+  // not one batch per move. Such a move is tested for contact only (the probe stops at the
+  // first level it meets): it adds to the run's `moves` and `last_line`, not to its volume
+  // or depth (docs/verification.md, "Runs of findings").
   std::size_t check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves, std::size_t from,
                     std::size_t to, std::vector<Event>& events);
   // The same for a live sample stream, which has no program to tell rapids by: moves[i] is
   // a rapid when rapid[i] is non-zero (the caller's speed test, docs/verification.md#live).
+  // Live sub-batches are short and their events are timed per sweep, so here every sweep
+  // after the first that meets material ends the call (no runs: only moves[from] can have
+  // findings).
   std::size_t check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                     std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to, std::vector<Event>& events);
 
@@ -101,7 +110,12 @@ class CollisionChecker {
     Intrusion what;
     double value = 0.0;  // Event::value
   };
+  // Both check()s; `runs`: moves that continue a run of findings stay in the batch.
+  std::size_t check_moves(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
+                          std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to,
+                          std::vector<Event>& events, bool runs);
   static constexpr int kMaxFindings = 6;
+  bool contact_only_ = false;  // check(): the move continues a run (IntrusionProbe::measure)
   using Findings = Finding[kMaxFindings];
   // The findings of one move against `solid`; returns how many were written. `rapid`: 1 / 0
   // the move is / is not a rapid, -1 the move's program segment tells.

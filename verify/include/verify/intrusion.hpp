@@ -29,7 +29,10 @@ class IntrusionProbe {
   // material farther than `margin_mm` inside each section polygon (a sweep that grazes a
   // wall within the margin, e.g. by the chord tolerance of two polygonised circles, has
   // deep_mm3 = 0).
-  [[nodiscard]] Intrusion measure(const geom::LbrSolid& solid, const geom::Sweep& sweep, double margin_mm);
+  // With `contact_only`, the levels are walked from the bottom up only until the first deep
+  // contact: deep_mm3 > 0 tells the same, volume_mm3 and depth_mm are those levels' only.
+  [[nodiscard]] Intrusion measure(const geom::LbrSolid& solid, const geom::Sweep& sweep, double margin_mm,
+                                  bool contact_only = false);
 
  private:
   void clip_to_rect(const geom::Path& p, const geom::Rect& r);
