@@ -102,22 +102,12 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   if (progress) progress(1.0);
 }
 
-// --design: the model read, checked and sliced before the run, so its errors come first.
-std::vector<geom::Paths> design_sections(const Profile& profile, const geom::LbrSolid& solid) {
-  if (profile.design.stl_path.empty()) return {};
-  const verify::StlMesh mesh = verify::read_stl(profile.design.stl_path);
-  verify::check_design(mesh, solid, profile.design.stl_path);
-  return verify::slice_design(mesh, solid);
-}
-
 // --design: the final stock against the design, and the move that made the deepest gouge.
 void compare_design(const Profile& profile, const std::vector<geom::Paths>& design,
                     const std::vector<motion::TimedSweep>& moves, const verify::MoveIndex& index, BatchResult& r) {
   if (profile.design.stl_path.empty()) return;
-  r.design = verify::compare_design(design, r.solid, profile.design.tolerance_mm);
-  verify::attribute_gouge(*r.design, r.solid, moves, index);
+  r.design = compare_with_design(profile, design, r.solid, moves, index, r.events);
   r.design_sections = design;
-  if (auto e = verify::gouge_event(*r.design, profile.design.tolerance_mm)) r.events.push_back(std::move(*e));
 }
 
 // over-travel: from the tool path alone, before the cut (its events come first).
@@ -127,6 +117,22 @@ void check_travel(const Profile& profile, const nc::Toolpath& path, int channel,
 }
 
 }  // namespace
+
+std::vector<geom::Paths> load_design(const Profile& profile, const geom::LbrSolid& solid) {
+  if (profile.design.stl_path.empty()) return {};
+  const verify::StlMesh mesh = verify::read_stl(profile.design.stl_path);
+  verify::check_design(mesh, solid, profile.design.stl_path);
+  return verify::slice_design(mesh, solid);
+}
+
+verify::DesignReport compare_with_design(const Profile& profile, const std::vector<geom::Paths>& design,
+                                         const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
+                                         const verify::MoveIndex& index, std::vector<verify::Event>& events) {
+  verify::DesignReport d = verify::compare_design(design, solid, profile.design.tolerance_mm);
+  if (!moves.empty()) verify::attribute_gouge(d, solid, moves, index);
+  if (auto e = verify::gouge_event(d, profile.design.tolerance_mm)) events.push_back(std::move(*e));
+  return d;
+}
 
 std::vector<std::string> toolpath_warnings(const nc::Toolpath& path) {
   std::vector<std::string> out;
@@ -180,7 +186,7 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
   verify::MoveIndex index;
   index.add(path, 0);
   check_travel(profile, path, 0, 0, r);
-  const std::vector<geom::Paths> design = design_sections(profile, r.solid);
+  const std::vector<geom::Paths> design = load_design(profile, r.solid);
   verify::CollisionChecker checker(profile.checks, tools, index);
   run_moves(profile, moves, r, progress, profile.checks.enabled ? &checker : nullptr);
   compare_design(profile, design, moves, index, r);
@@ -204,7 +210,7 @@ BatchResult run_batch_channels(const Profile& profile, const std::vector<Channel
     check_travel(profile, path, static_cast<int>(k), base, r);
     base += static_cast<geom::MoveId>(path.segments.size());
   }
-  const std::vector<geom::Paths> design = design_sections(profile, r.solid);
+  const std::vector<geom::Paths> design = load_design(profile, r.solid);
   verify::CollisionChecker checker(profile.checks, tools, index);
   run_moves(profile, plan.sweeps, r, progress, profile.checks.enabled ? &checker : nullptr);
   compare_design(profile, design, plan.sweeps, index, r);
