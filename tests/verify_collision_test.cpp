@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "app/batch.hpp"
+#include "nc/emulator.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "nc/gcode.hpp"
@@ -31,6 +32,15 @@ app::BatchResult run(const app::Profile& profile, const std::string& program) {
   p.threads = 1;
   const nc::Toolpath path = nc::interpret_gcode(program, "t.ngc", app::gcode_options(p));
   return app::run_batch(p, path);
+}
+
+// `batch --sampled`: the emulator's sampled stream of the program (app::emulator_limits:
+// 4 ms samples, 1000 mm/s2), run with the sampled stream's checks.
+app::BatchResult run_sampled(const app::Profile& profile, const std::string& program) {
+  app::Profile p = profile;
+  p.threads = 1;
+  const nc::Toolpath path = nc::interpret_gcode(program, "t.ngc", app::gcode_options(p));
+  return app::run_batch(p, nc::sampled_toolpath(path, app::emulator_limits(p)), {}, true);
 }
 
 const verify::Event* first_of(const std::vector<verify::Event>& ev, verify::EventKind k) {
@@ -362,3 +372,59 @@ TEST(CheckProfile, TravelLimitsAndTheCentreCuttingFlagAreRead) {
   EXPECT_NE(error_of(ball).find("tool.centre_cutting: only for tool kinds flat and bull"), std::string::npos)
       << error_of(ball);
 }
+
+// batch --sampled (docs/verification.md#sampled): a G0 at 15 m/min through the stock is a
+// rapid by its sample speed (above 1.05 x 7500 mm/min, half the rapid rate: the default
+// profile has no feed cap), at its line, with the slot's volume (100 x 10 x 1: it starts and
+// ends 60 mm outside the stock, so its acceleration ramps are in the air). The same path as
+// G1 F1000 raises nothing.
+TEST(SampledChecks, ARapidIsToldBySampleSpeedAtItsLineWithItsVolume) {
+  const std::string head = "G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X-60 Y40 Z5\nG1 Z-1 F1000\n";
+  const app::BatchResult r = run_sampled(app::default_profile(), head + "G0 X160\nG0 Z10\nM2\n");
+  ASSERT_EQ(r.events.size(), 1u) << verify::describe(r.events.at(1));
+  const verify::Event& e = r.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::RapidIntoMaterial);
+  EXPECT_EQ(e.line, 5);
+  EXPECT_EQ(e.last_line, 5);
+  EXPECT_EQ(e.source, "t.ngc");
+  EXPECT_GT(e.moves, 100u);  // samples, 1 mm apart
+  EXPECT_NEAR(e.volume_mm3, 1000.0, 0.01 * 1000.0);
+  EXPECT_NEAR(e.depth_mm, 1.0, 1e-6);
+  EXPECT_NEAR(r.removed_volume_mm3, e.volume_mm3, 1e-6 * 1000.0);
+  const app::BatchResult feed = run_sampled(app::default_profile(), head + "G1 X160\nG0 Z10\nM2\n");
+  EXPECT_TRUE(feed.events.empty()) << verify::describe(feed.events.at(0));
+  EXPECT_NEAR(feed.removed_volume_mm3, r.removed_volume_mm3, 1e-3);
+}
+
+// The sampled stream keeps each program move's spindle state: a cut after M5 raises
+// spindle-off at its line with the 30 x 10 x 2 it cuts (as in batch, within 1 %).
+TEST(SampledChecks, ACutAfterM5RaisesSpindleOffAtItsLine) {
+  const std::string head = "G21 G90 G17\nT1 M6 G43 H1\nS1000 M3\nG0 X-10 Y40 Z5\nG1 Z-2 F300\nG1 X30 F600\n";
+  const app::BatchResult bad = run_sampled(app::default_profile(), head + "M5\nG1 X60\nG0 Z10\nM2\n");
+  ASSERT_EQ(bad.events.size(), 1u) << verify::describe(bad.events.at(1));
+  const verify::Event& e = bad.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::SpindleOff);
+  EXPECT_EQ(e.line, 8);
+  EXPECT_NEAR(e.volume_mm3, 600.0, 0.01 * 600.0);
+  EXPECT_DOUBLE_EQ(e.value, 1000.0);
+  const app::BatchResult good = run_sampled(app::default_profile(), head + "G1 X60\nG0 Z10\nM2\n");
+  EXPECT_TRUE(good.events.empty()) << verify::describe(good.events.at(0));
+}
+
+// The feed limit judges the sample speed: F1500 over a 1000 mm/min limit while cutting is a
+// warning at its line with the feed reached (the emulator runs at the programmed feed) and
+// about its 600 mm3 (the deceleration's last 0.14 mm below the limit are not counted).
+TEST(SampledChecks, AFeedOverTheLimitIsJudgedBySampleSpeed) {
+  app::Profile p = app::default_profile();
+  p.checks.max_cutting_feed_mm_per_min = 1000.0;
+  const app::BatchResult r = run_sampled(p,
+                                         "G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X-10 Y40 Z5\nG1 X-8 F3000\n"
+                                         "G1 Z-2 F300\nG1 X30 F600\nG1 X60 F1500\nG0 Z10\nM2\n");
+  ASSERT_EQ(r.events.size(), 1u) << verify::describe(r.events.at(1));
+  const verify::Event& e = r.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::FeedLimit);
+  EXPECT_EQ(e.line, 7);
+  EXPECT_NEAR(e.value, 1500.0, 1.0);
+  EXPECT_NEAR(e.volume_mm3, 600.0, 0.01 * 600.0);
+}
+

@@ -315,7 +315,7 @@ int run_batch_command(const BatchOptions& o) {
   if (!o.quiet) {
     progress = [](double f) { spdlog::info("progress {:5.1f} %", 100.0 * f); };
   }
-  app::BatchResult r = app::run_batch(profile, path, progress);
+  app::BatchResult r = app::run_batch(profile, path, progress, o.sampled);
   if (emulated) r.machining_time_s = emulated_time_s;
   app::write_batch_outputs(o.out, r, profile, program);
   print_result(r, o);
@@ -685,7 +685,7 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
   add_start_tool_option(batch, b.start_tool);
   batch->add_flag("--sampled", b.sampled,
                   "Run the kernel on the machine emulator's sampled stream (as live mode sees it) instead of the "
-                  "interpreted segments");
+                  "interpreted segments; the checks tell rapids by sample speed, as live mode does");
   batch->add_option("--profile", b.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
   batch->add_option("--stock", b.stock,
                     "Override the stock: box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX or cylinder:DIAMETER,ZMIN,ZMAX [mm]");

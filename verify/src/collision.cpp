@@ -83,8 +83,9 @@ int CollisionChecker::segment_findings(const geom::LbrSolid& solid, const motion
   const bool rapid = rapid_flag >= 0 ? rapid_flag > 0 : seg != nullptr && seg->kind == nc::SegmentKind::Rapid;
   const bool spindle_off = seg != nullptr && !seg->spindle_turning();
   const double feed_limit = config_.max_cutting_feed_mm_per_min;
-  const bool too_fast =
-      seg != nullptr && seg->kind == nc::SegmentKind::Feed && feed_limit > 0.0 && seg->feed_mm_per_min > feed_limit;
+  // A rapid is judged as one (a sampled rapid is a Feed segment at the rapid's speed).
+  const bool too_fast = !rapid && seg != nullptr && seg->kind == nc::SegmentKind::Feed && feed_limit > 0.0 &&
+                        seg->feed_mm_per_min > feed_limit;
   if (rapid || spindle_off || too_fast) {
     const Intrusion in = probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm);
     if (in.deep_mm3 > 0.0) {

@@ -46,8 +46,11 @@ std::vector<std::string> toolpath_warnings(const nc::Toolpath& path);
 // when the path uses a tool the profile does not define, or (profile.design set) when the
 // design model cannot be read or compared (verify::StlError, verify::DesignError), before
 // the run. Segments with tool 0 (empty
-// spindle) remove nothing.
-[[nodiscard]] BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress = {});
+// spindle) remove nothing. `sampled`: `path` is the emulator's sampled stream
+// (nc::sampled_toolpath, `batch --sampled`), whose rapids the checks tell by speed as live
+// mode does (docs/verification.md "batch --sampled").
+[[nodiscard]] BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress = {},
+                                    bool sampled = false);
 
 // One channel of a multi-channel run: its name, tool path and kinematics.
 using ChannelPath = motion::ChannelPath;

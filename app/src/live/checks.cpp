@@ -10,14 +10,9 @@ namespace lbr::app::live {
 
 namespace {
 
-// A step faster than the max cutting feed by more than this is fast: the emulator caps feeds
-// at the limit exactly, and sampled positions carry rounding (docs/verification.md#live).
-constexpr double kFastMargin = 1.05;
-
-// The profile's max cutting feed: [machine] max_feed_mm_per_min, or half the rapid rate
-// when the profile sets no feed cap [mm/min].
+// The profile's max cutting feed (verify::rapid_threshold_mm_per_min) [mm/min].
 double rapid_threshold(const Profile& p) {
-  return p.machine.max_feed_mm_per_min > 0.0 ? p.machine.max_feed_mm_per_min : 0.5 * p.machine.rapid_mm_per_min;
+  return verify::rapid_threshold_mm_per_min(p.machine.max_feed_mm_per_min, p.machine.rapid_mm_per_min);
 }
 
 gfx::AlarmSeverity alarm_severity(verify::Severity s) noexcept {
@@ -33,7 +28,7 @@ LiveChecks::LiveChecks(const Profile& profile, const motion::ToolTable& tools, s
       period_s_(profile.live.period_ms * 1e-3),
       checker_(profile.checks, tools, index_),
       lines_(std::move(lines)) {
-  fast_step_mm_ = kFastMargin * rapid_mm_per_min_ / 60.0 * period_s_;
+  fast_step_mm_ = verify::kFastMargin * rapid_mm_per_min_ / 60.0 * period_s_;
   moves_.reserve(batch_capacity);
   info_.reserve(batch_capacity);
   rapid_.reserve(batch_capacity);

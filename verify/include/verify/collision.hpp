@@ -48,6 +48,16 @@ struct CheckConfig {
   double max_ramp_angle_deg = 3.0;
 };
 
+// A sampled stream has no G0 (live mode, batch --sampled): a step is a rapid when it moves the
+// tip faster than kFastMargin times rapid_threshold_mm_per_min() — the emulator caps feeds at
+// the limit exactly and sampled positions carry rounding (docs/verification.md#live).
+inline constexpr double kFastMargin = 1.05;
+// The profile's max cutting feed: `max_feed_mm_per_min` ([machine] max_feed_mm_per_min), or
+// half of `rapid_mm_per_min` when the profile sets no feed cap (0) [mm/min].
+[[nodiscard]] inline double rapid_threshold_mm_per_min(double max_feed_mm_per_min, double rapid_mm_per_min) noexcept {
+  return max_feed_mm_per_min > 0.0 ? max_feed_mm_per_min : 0.5 * rapid_mm_per_min;
+}
+
 // The centre core of a non-centre-cutting tool (the part of the end face that does not cut)
 // is taken as this fraction of its cutting diameter (docs/verification.md).
 inline constexpr double kNonCuttingCoreFraction = 0.25;
