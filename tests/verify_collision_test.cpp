@@ -329,12 +329,16 @@ TEST(Events, CsvHasOneLinePerEventAndQuotesSources) {
 TEST(CheckProfile, KeysAreReadAndTyposRejected) {
   const std::string base = app::default_profile_text();
   const app::Profile p = app::parse_profile(base + "\n[checks]\nenabled = false\ntolerance_mm = 0.05\n"
-                                                   "max_cutting_feed_mm_per_min = 2500\nmax_ramp_angle_deg = 5\n",
+                                                   "max_cutting_feed_mm_per_min = 2500\nmax_ramp_angle_deg = 5\n"
+                                                   "spindle_nose_diameter_mm = 90\nspindle_nose_length_mm = 120\n",
                                             "c.toml");
   EXPECT_FALSE(p.checks.enabled);
   EXPECT_DOUBLE_EQ(p.checks.tolerance_mm, 0.05);
   EXPECT_DOUBLE_EQ(p.checks.max_cutting_feed_mm_per_min, 2500.0);
   EXPECT_DOUBLE_EQ(p.checks.max_ramp_angle_deg, 5.0);
+  EXPECT_DOUBLE_EQ(p.checks.spindle_nose_diameter_mm, 90.0);
+  EXPECT_DOUBLE_EQ(p.checks.spindle_nose_length_mm, 120.0);
+  EXPECT_DOUBLE_EQ(app::default_profile().checks.spindle_nose_diameter_mm, 0.0);  // not checked unless given
   try {
     (void)app::parse_profile(base + "\n[checks]\ntolerance = 0.05\n", "c.toml");
     FAIL() << "unknown key accepted";
@@ -428,3 +432,39 @@ TEST(SampledChecks, AFeedOverTheLimitIsJudgedBySampleSpeed) {
   EXPECT_NEAR(e.volume_mm3, 600.0, 0.01 * 600.0);
 }
 
+// [checks] spindle_nose_diameter_mm / spindle_nose_length_mm (docs/verification.md): the nose
+// (D80 x 100 here) starts at the holder's top face, tip + 60 (T1) + 40 (holder) = 100 mm up.
+// T1 goes down beside the stock (X-35, the stock starts at X0) to Z-105: tool (r 5) and
+// holder (r 20) stay clear, the nose (r 40) dips 5 mm into the stock over a circular segment
+// 5 mm wide: 1600 acos(35/40) - 35 sqrt(40^2 - 35^2) = 130.8 mm2 x 5 mm = 654 mm3, from the
+// line of that move (and as much again on the retract). At X-45 the nose clears the stock's X0 face: nothing. Without the keys
+// the nose is not checked.
+TEST(CollisionChecks, TheSpindleNoseBesideTheStockIsReportedAtItsLine) {
+  app::Profile p = app::default_profile();
+  p.checks.spindle_nose_diameter_mm = 80.0;
+  p.checks.spindle_nose_length_mm = 100.0;
+  const auto program = [](const char* x) {
+    return std::string("G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X") + x + " Y40 Z5\nG1 Z-105 F1000\nG0 Z10\nM2\n";
+  };
+  const app::BatchResult r = run(p, program("-35"));
+  const verify::Event* e = first_of(r.events, verify::EventKind::SpindleNoseInMaterial);
+  ASSERT_NE(e, nullptr) << (r.events.empty() ? "no events" : verify::describe(r.events[0]));
+  EXPECT_EQ(e->line, 4);
+  EXPECT_EQ(e->severity(), verify::Severity::Error);
+  EXPECT_EQ(std::string(verify::to_string(e->kind)), "spindle-nose-in-material");
+  // The retract (line 5) goes back up through the same material (nothing was cut): the two
+  // consecutive moves are one event, with the volume each met.
+  EXPECT_EQ(e->moves, 2u);
+  EXPECT_EQ(e->last_line, 5);
+  const double segment_mm2 = 1600.0 * std::acos(35.0 / 40.0) - 35.0 * std::sqrt(1600.0 - 1225.0);
+  EXPECT_NEAR(e->volume_mm3, 2.0 * segment_mm2 * 5.0, 0.01 * 2.0 * segment_mm2 * 5.0);
+  EXPECT_NEAR(e->depth_mm, 5.0, 0.1);
+  EXPECT_EQ(count_kind(r.events, verify::EventKind::HolderInMaterial), 0u);
+  EXPECT_EQ(count_kind(r.events, verify::EventKind::ShankInMaterial), 0u);
+  EXPECT_NEAR(r.removed_volume_mm3, 0.0, 1e-9);  // the tool cuts nothing
+
+  const app::BatchResult clear = run(p, program("-45"));
+  EXPECT_EQ(count_kind(clear.events, verify::EventKind::SpindleNoseInMaterial), 0u);
+  const app::BatchResult off = run(program("-35"));
+  EXPECT_EQ(count_kind(off.events, verify::EventKind::SpindleNoseInMaterial), 0u);
+}

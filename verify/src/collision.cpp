@@ -63,6 +63,11 @@ CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::Tool
     p.has_shank = tool.length_mm - p.shank_from_mm > 0.0;
     if (p.has_shank) p.shank = cylinder(shank_d, tool.length_mm - p.shank_from_mm, tools.chord_tol_mm());
     p.holder = cylinder(tool.holder_diameter_mm, tool.holder_length_mm, tools.chord_tol_mm());
+    p.has_nose = config.spindle_nose_diameter_mm > 0.0 && config.spindle_nose_length_mm > 0.0;
+    if (p.has_nose) {
+      p.nose_from_mm = tool.length_mm + tool.holder_length_mm + config.tolerance_mm;
+      p.nose = cylinder(config.spindle_nose_diameter_mm, config.spindle_nose_length_mm, tools.chord_tol_mm());
+    }
     p.centre_cutting = tool.centre_cutting;
     if (!p.centre_cutting)
       p.core = cylinder(kNonCuttingCoreFraction * tool.diameter_mm, tool.flute_length_mm, tools.chord_tol_mm());
@@ -106,17 +111,19 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
       if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
     }
   }
-  if (p.has_shank) {
-    const Intrusion in =
-        probe_.measure(solid, geom::Sweep(p.shank, raised(m.ref.from, p.shank_from_mm), raised(m.ref.to, p.shank_from_mm)),
-                       config_.tolerance_mm);
-    if (in.deep_mm3 > 0.0) out[n++] = {EventKind::ShankInMaterial, in};
-  }
-  const Intrusion in =
-      probe_.measure(solid, geom::Sweep(p.holder, raised(m.ref.from, p.holder_from_mm), raised(m.ref.to, p.holder_from_mm)),
-                     config_.tolerance_mm);
-  if (in.deep_mm3 > 0.0) out[n++] = {EventKind::HolderInMaterial, in};
+  if (p.has_shank && raised_finding(solid, m, p.shank, p.shank_from_mm, EventKind::ShankInMaterial, out[n])) ++n;
+  if (raised_finding(solid, m, p.holder, p.holder_from_mm, EventKind::HolderInMaterial, out[n])) ++n;
+  if (p.has_nose && raised_finding(solid, m, p.nose, p.nose_from_mm, EventKind::SpindleNoseInMaterial, out[n])) ++n;
   return n;
+}
+
+bool CollisionChecker::raised_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m,
+                                      const geom::CutterShape& part, double from_mm, EventKind kind, Finding& out) {
+  const Intrusion in =
+      probe_.measure(solid, geom::Sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm)), config_.tolerance_mm);
+  if (!(in.deep_mm3 > 0.0)) return false;
+  out = {kind, in};
+  return true;
 }
 
 Event CollisionChecker::event_of(const motion::TimedSweep& m, const Finding& f) const {
