@@ -90,6 +90,32 @@ std::optional<Workload> linuxcnc_workload(const LinuxcncSample& s, const std::st
   return w;
 }
 
+// One table row: into the CSV and on stdout.
+void print_row(FILE* f, const Workload& w, const std::string& mode, const std::string& g, const std::string& checks,
+               double machining, const nc::Toolpath& path, const app::BatchResult& r, const bench::ReferenceVolume* ref) {
+  const double factor = r.wall_time_s / machining;
+  const double err = ref ? (r.removed_volume_mm3 - ref->removed_mm3) / ref->removed_mm3 : 0.0;
+  std::fprintf(f, "%s,%s,%d,%.2f,%.4f,%.5f,%.3f,%zu,%.1f,%s,%zu,", w.name.c_str(), g.c_str(), r.solid.regions(), machining,
+               r.wall_time_s, factor, r.removed_volume_mm3, r.solid.vertex_count(), app::peak_rss_mb(), mode.c_str(),
+               path.segments.size());
+  if (ref) std::fprintf(f, "%.3f,%.6f,%s\n", ref->removed_mm3, err, checks.c_str());
+  else std::fprintf(f, ",,%s\n", checks.c_str());
+  std::fflush(f);
+  if (w.both_modes)
+    std::printf("%-8s %-8s %-6s (%3dx%-3d) checks %-3s %7zu moves  machining %7.2f s  simulated %8.3f s  factor %.5f  "
+                "removed %.1f mm3",
+                w.name.c_str(), mode.c_str(), g.c_str(), r.solid.regions_x(), r.solid.regions_y(), checks.c_str(),
+                path.segments.size(), machining, r.wall_time_s, factor, r.removed_volume_mm3);
+  else
+    std::printf("%-7s %-6s (%3dx%-3d) checks %-3s machining %7.2f s  simulated %8.3f s  factor %.5f  removed %.1f mm3",
+                w.name.c_str(), g.c_str(), r.solid.regions_x(), r.solid.regions_y(), checks.c_str(), machining,
+                r.wall_time_s, factor, r.removed_volume_mm3);
+  if (ref) std::printf("  vs reference %+.4f %%", 100.0 * err);
+  if (!r.events.empty()) std::printf("  %zu events", r.events.size());
+  std::printf("\n");
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -102,6 +128,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> grids{"1x1", "2x2", "4x2", "4x4", "8x4", "8x8", "16x16", "auto"};
   std::vector<std::string> workloads{"low", "medium", "high", "finish3d", "helix", "finish5x", "linuxcnc"};
   std::vector<std::string> modes{"segments", "sampled"};
+  std::vector<std::string> checks{"on"};
   bool plot_only = false;
   cli.add_option("--out", dir, "Output directory")->capture_default_str();
   cli.add_option("--programs", programs, "Directory of the workloads' .ngc (lbr-genbench's output)")->capture_default_str();
@@ -112,6 +139,9 @@ int main(int argc, char** argv) {
                  "modes), linuxcnc (= boat-xyzac boat-xyzbc impeller-7bl-xyzac, skipped when not installed) or one of those")
       ->capture_default_str();
   cli.add_option("--modes", modes, "Modes of the issue 13 workloads: segments (lbrsim batch), sampled (--sampled)")
+      ->capture_default_str();
+  cli.add_option("--checks", checks, "Collision checks during the run: on (lbrsim batch's default), off, or both")
+      ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   cli.add_option("--mill5-profile", mill5, "Profile of finish5x and the LinuxCNC samples")->capture_default_str();
   cli.add_option("--linuxcnc-dir", linuxcnc, "Folder of LinuxCNC's boat/impeller samples")->capture_default_str();
@@ -137,7 +167,7 @@ int main(int argc, char** argv) {
   if (f == nullptr && !plot_only) return 1;
   if (!plot_only) {
   std::fprintf(f, "workload,grid,regions,machining_s,sim_s,factor,removed_mm3,vertices,peak_rss_mb,mode,moves,"
-                  "reference_mm3,volume_error\n");
+                  "reference_mm3,volume_error,checks\n");
   for (const std::string& name : workloads) {
     // Load the workload(s) the name stands for.
     std::vector<Workload> load;
@@ -182,30 +212,14 @@ int main(int argc, char** argv) {
         // As lbrsim batch builds its input: the program's segments, or with --sampled the
         // emulator's sampled stream (nc::sampled_toolpath); the machining time is the emulator's.
         const nc::Toolpath path = mode == "sampled" ? nc::sampled_toolpath(w.program, limits) : w.program;
-        for (const std::string& g : grids) {
-          app::Profile prof = w.prof;
-          app::apply_regions(prof, g, "--grids");
-          const app::BatchResult r = app::run_batch(prof, path);
-          const double factor = r.wall_time_s / machining;
-          const double err = ref ? (r.removed_volume_mm3 - ref->removed_mm3) / ref->removed_mm3 : 0.0;
-          std::fprintf(f, "%s,%s,%d,%.2f,%.4f,%.5f,%.3f,%zu,%.1f,%s,%zu,", w.name.c_str(), g.c_str(), r.solid.regions(),
-                       machining, r.wall_time_s, factor, r.removed_volume_mm3, r.solid.vertex_count(), app::peak_rss_mb(),
-                       mode.c_str(), path.segments.size());
-          if (ref) std::fprintf(f, "%.3f,%.6f\n", ref->removed_mm3, err);
-          else std::fprintf(f, ",\n");
-          std::fflush(f);
-          if (w.both_modes)
-            std::printf("%-8s %-8s %-6s (%3dx%-3d) %7zu moves  machining %7.2f s  simulated %8.3f s  factor %.5f  removed %.1f mm3",
-                        w.name.c_str(), mode.c_str(), g.c_str(), r.solid.regions_x(), r.solid.regions_y(), path.segments.size(),
-                        machining, r.wall_time_s, factor, r.removed_volume_mm3);
-          else
-            std::printf("%-7s %-6s (%3dx%-3d) machining %7.2f s  simulated %8.3f s  factor %.5f  removed %.1f mm3", w.name.c_str(),
-                        g.c_str(), r.solid.regions_x(), r.solid.regions_y(), machining, r.wall_time_s, factor,
-                        r.removed_volume_mm3);
-          if (ref) std::printf("  vs reference %+.4f %%", 100.0 * err);
-          std::printf("\n");
-          std::fflush(stdout);
-        }
+        for (const std::string& g : grids)
+          for (const std::string& c : checks) {
+            app::Profile prof = w.prof;
+            app::apply_regions(prof, g, "--grids");
+            prof.checks.enabled = c == "on";
+            const app::BatchResult r = app::run_batch(prof, path);
+            print_row(f, w, mode, g, c, machining, path, r, ref ? &*ref : nullptr);
+          }
       }
     }
   }

@@ -85,6 +85,8 @@ TEST(BundledProfiles, Mill5AC) {
   EXPECT_EQ(o.rotary, (std::array<bool, 3>{true, false, true}));
   EXPECT_EQ(o.tool_lengths.at(1), 60.0);
   EXPECT_EQ(o.work_offsets[0][nc::Z], -250.0);
+  EXPECT_EQ(p.checks.spindle_nose_diameter_mm, 100.0);  // verify
+  EXPECT_EQ(p.checks.spindle_nose_length_mm, 150.0);
 }
 
 TEST(BundledProfiles, Lathe) {

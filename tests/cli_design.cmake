@@ -52,3 +52,38 @@ execute_process(COMMAND "${LBRSIM}" batch --quiet --out "${OUT}/fail" --design "
 if(NOT rc EQUAL 3 OR NOT "${out}${err}" MATCHES "checks: 1 error,.*design-gouge")
   message(FATAL_ERROR "--design stock.stl --fail-on error: exit ${rc} (expected 3): ${out} ${err}")
 endif()
+
+# `lbrsim run --design` (docs/verification.md#live-design): the emulated demo compared when
+# the run ends, by batch's comparison: gouge = the run's removed volume (to the integer mm3),
+# within 1 % of batch's, no excess, deviation.csv and a design-gouge event in events.csv.
+execute_process(COMMAND "${LBRSIM}" run --source emulator:demo --speed 0 --no-window --quiet --out "${OUT}/live"
+                        --design "${OUT}/stock.stl"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "design: gouge [0-9.]+ mm3")
+  message(FATAL_ERROR "run --design stock.stl: exit ${rc}: ${out} ${err}")
+endif()
+file(READ "${OUT}/live/metrics.json" m)
+string(JSON live_removed GET "${m}" removed_volume_mm3)
+string(JSON live_gouge GET "${m}" design_gouge_mm3)
+string(JSON live_excess GET "${m}" design_excess_mm3)
+string(REGEX MATCH "^[0-9]+" live_removed_mm3 "${live_removed}")
+string(REGEX MATCH "^[0-9]+" live_gouge_mm3 "${live_gouge}")
+math(EXPR diff "${live_gouge_mm3} - ${gouge_mm3}")
+if(diff LESS 0)
+  math(EXPR diff "0 - ${diff}")
+endif()
+math(EXPR diff100 "${diff} * 100")
+file(READ "${OUT}/live/events.csv" events)
+if(NOT live_removed_mm3 EQUAL live_gouge_mm3 OR live_excess GREATER 0.001 OR diff100 GREATER gouge_mm3
+   OR NOT EXISTS "${OUT}/live/deviation.csv" OR NOT events MATCHES "design-gouge")
+  message(FATAL_ERROR "run --design stock.stl: gouge ${live_gouge} mm3 (removed ${live_removed}, batch ${gouge}), "
+                      "excess ${live_excess} mm3: ${events}")
+endif()
+# --color deviation without a design model is a usage error, for run and view alike.
+execute_process(COMMAND "${LBRSIM}" run --no-window --color deviation RESULT_VARIABLE rc_run ERROR_VARIABLE err_run)
+execute_process(COMMAND "${LBRSIM}" view --color deviation RESULT_VARIABLE rc_view ERROR_VARIABLE err_view)
+if(NOT rc_run EQUAL 1 OR NOT err_run MATCHES "--color deviation needs --design" OR NOT rc_view EQUAL 1
+   OR NOT err_view MATCHES "--color deviation needs --design")
+  message(FATAL_ERROR "--color deviation without --design: run exit ${rc_run}, view exit ${rc_view} (expected 1): "
+                      "${err_run} ${err_view}")
+endif()

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "app/batch.hpp"
+#include "nc/emulator.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "nc/gcode.hpp"
@@ -31,6 +32,15 @@ app::BatchResult run(const app::Profile& profile, const std::string& program) {
   p.threads = 1;
   const nc::Toolpath path = nc::interpret_gcode(program, "t.ngc", app::gcode_options(p));
   return app::run_batch(p, path);
+}
+
+// `batch --sampled`: the emulator's sampled stream of the program (app::emulator_limits:
+// 4 ms samples, 1000 mm/s2), run with the sampled stream's checks.
+app::BatchResult run_sampled(const app::Profile& profile, const std::string& program) {
+  app::Profile p = profile;
+  p.threads = 1;
+  const nc::Toolpath path = nc::interpret_gcode(program, "t.ngc", app::gcode_options(p));
+  return app::run_batch(p, nc::sampled_toolpath(path, app::emulator_limits(p)), {}, true);
 }
 
 const verify::Event* first_of(const std::vector<verify::Event>& ev, verify::EventKind k) {
@@ -340,12 +350,16 @@ TEST(Events, CsvHasOneLinePerEventAndQuotesSources) {
 TEST(CheckProfile, KeysAreReadAndTyposRejected) {
   const std::string base = app::default_profile_text();
   const app::Profile p = app::parse_profile(base + "\n[checks]\nenabled = false\ntolerance_mm = 0.05\n"
-                                                   "max_cutting_feed_mm_per_min = 2500\nmax_ramp_angle_deg = 5\n",
+                                                   "max_cutting_feed_mm_per_min = 2500\nmax_ramp_angle_deg = 5\n"
+                                                   "spindle_nose_diameter_mm = 90\nspindle_nose_length_mm = 120\n",
                                             "c.toml");
   EXPECT_FALSE(p.checks.enabled);
   EXPECT_DOUBLE_EQ(p.checks.tolerance_mm, 0.05);
   EXPECT_DOUBLE_EQ(p.checks.max_cutting_feed_mm_per_min, 2500.0);
   EXPECT_DOUBLE_EQ(p.checks.max_ramp_angle_deg, 5.0);
+  EXPECT_DOUBLE_EQ(p.checks.spindle_nose_diameter_mm, 90.0);
+  EXPECT_DOUBLE_EQ(p.checks.spindle_nose_length_mm, 120.0);
+  EXPECT_DOUBLE_EQ(app::default_profile().checks.spindle_nose_diameter_mm, 0.0);  // not checked unless given
   try {
     (void)app::parse_profile(base + "\n[checks]\ntolerance = 0.05\n", "c.toml");
     FAIL() << "unknown key accepted";
@@ -382,4 +396,97 @@ TEST(CheckProfile, TravelLimitsAndTheCentreCuttingFlagAreRead) {
                            "\n[[tool]]\nnumber = 6\nkind = \"ball\"\ndiameter_mm = 6.0\ncentre_cutting = false\n";
   EXPECT_NE(error_of(ball).find("tool.centre_cutting: only for tool kinds flat and bull"), std::string::npos)
       << error_of(ball);
+}
+
+// batch --sampled (docs/verification.md#sampled): a G0 at 15 m/min through the stock is a
+// rapid by its sample speed (above 1.05 x 7500 mm/min, half the rapid rate: the default
+// profile has no feed cap), at its line, with the slot's volume (100 x 10 x 1: it starts and
+// ends 60 mm outside the stock, so its acceleration ramps are in the air). The same path as
+// G1 F1000 raises nothing.
+TEST(SampledChecks, ARapidIsToldBySampleSpeedAtItsLineWithItsVolume) {
+  const std::string head = "G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X-60 Y40 Z5\nG1 Z-1 F1000\n";
+  const app::BatchResult r = run_sampled(app::default_profile(), head + "G0 X160\nG0 Z10\nM2\n");
+  ASSERT_EQ(r.events.size(), 1u) << verify::describe(r.events.at(1));
+  const verify::Event& e = r.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::RapidIntoMaterial);
+  EXPECT_EQ(e.line, 5);
+  EXPECT_EQ(e.last_line, 5);
+  EXPECT_EQ(e.source, "t.ngc");
+  EXPECT_GT(e.moves, 100u);  // samples, 1 mm apart
+  EXPECT_NEAR(e.volume_mm3, 1000.0, 0.01 * 1000.0);
+  EXPECT_NEAR(e.depth_mm, 1.0, 1e-6);
+  EXPECT_NEAR(r.removed_volume_mm3, e.volume_mm3, 1e-6 * 1000.0);
+  const app::BatchResult feed = run_sampled(app::default_profile(), head + "G1 X160\nG0 Z10\nM2\n");
+  EXPECT_TRUE(feed.events.empty()) << verify::describe(feed.events.at(0));
+  EXPECT_NEAR(feed.removed_volume_mm3, r.removed_volume_mm3, 1e-3);
+}
+
+// The sampled stream keeps each program move's spindle state: a cut after M5 raises
+// spindle-off at its line with the 30 x 10 x 2 it cuts (as in batch, within 1 %).
+TEST(SampledChecks, ACutAfterM5RaisesSpindleOffAtItsLine) {
+  const std::string head = "G21 G90 G17\nT1 M6 G43 H1\nS1000 M3\nG0 X-10 Y40 Z5\nG1 Z-2 F300\nG1 X30 F600\n";
+  const app::BatchResult bad = run_sampled(app::default_profile(), head + "M5\nG1 X60\nG0 Z10\nM2\n");
+  ASSERT_EQ(bad.events.size(), 1u) << verify::describe(bad.events.at(1));
+  const verify::Event& e = bad.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::SpindleOff);
+  EXPECT_EQ(e.line, 8);
+  EXPECT_NEAR(e.volume_mm3, 600.0, 0.01 * 600.0);
+  EXPECT_DOUBLE_EQ(e.value, 1000.0);
+  const app::BatchResult good = run_sampled(app::default_profile(), head + "G1 X60\nG0 Z10\nM2\n");
+  EXPECT_TRUE(good.events.empty()) << verify::describe(good.events.at(0));
+}
+
+// The feed limit judges the sample speed: F1500 over a 1000 mm/min limit while cutting is a
+// warning at its line with the feed reached (the emulator runs at the programmed feed) and
+// about its 600 mm3 (the deceleration's last 0.14 mm below the limit are not counted).
+TEST(SampledChecks, AFeedOverTheLimitIsJudgedBySampleSpeed) {
+  app::Profile p = app::default_profile();
+  p.checks.max_cutting_feed_mm_per_min = 1000.0;
+  const app::BatchResult r = run_sampled(p,
+                                         "G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X-10 Y40 Z5\nG1 X-8 F3000\n"
+                                         "G1 Z-2 F300\nG1 X30 F600\nG1 X60 F1500\nG0 Z10\nM2\n");
+  ASSERT_EQ(r.events.size(), 1u) << verify::describe(r.events.at(1));
+  const verify::Event& e = r.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::FeedLimit);
+  EXPECT_EQ(e.line, 7);
+  EXPECT_NEAR(e.value, 1500.0, 1.0);
+  EXPECT_NEAR(e.volume_mm3, 600.0, 0.01 * 600.0);
+}
+
+// [checks] spindle_nose_diameter_mm / spindle_nose_length_mm (docs/verification.md): the nose
+// (D80 x 100 here) starts at the holder's top face, tip + 60 (T1) + 40 (holder) = 100 mm up.
+// T1 goes down beside the stock (X-35, the stock starts at X0) to Z-105: tool (r 5) and
+// holder (r 20) stay clear, the nose (r 40) dips 5 mm into the stock over a circular segment
+// 5 mm wide: 1600 acos(35/40) - 35 sqrt(40^2 - 35^2) = 130.8 mm2 x 5 mm = 654 mm3, from the
+// line of that move (and as much again on the retract). At X-45 the nose clears the stock's X0 face: nothing. Without the keys
+// the nose is not checked.
+TEST(CollisionChecks, TheSpindleNoseBesideTheStockIsReportedAtItsLine) {
+  app::Profile p = app::default_profile();
+  p.checks.spindle_nose_diameter_mm = 80.0;
+  p.checks.spindle_nose_length_mm = 100.0;
+  const auto program = [](const char* x) {
+    return std::string("G21 G90 G17\nT1 M6 G43 H1 S1000 M3\nG0 X") + x + " Y40 Z5\nG1 Z-105 F1000\nG0 Z10\nM2\n";
+  };
+  const app::BatchResult r = run(p, program("-35"));
+  const verify::Event* e = first_of(r.events, verify::EventKind::SpindleNoseInMaterial);
+  ASSERT_NE(e, nullptr) << (r.events.empty() ? "no events" : verify::describe(r.events[0]));
+  EXPECT_EQ(e->line, 4);
+  EXPECT_EQ(e->severity(), verify::Severity::Error);
+  EXPECT_EQ(std::string(verify::to_string(e->kind)), "spindle-nose-in-material");
+  // The retract (line 5) goes back up through the same material (nothing was cut): the two
+  // consecutive moves are one event. The retract continues the run, so it is tested for
+  // contact only: the volume is the plunge's (docs/verification.md, "Runs of findings").
+  EXPECT_EQ(e->moves, 2u);
+  EXPECT_EQ(e->last_line, 5);
+  const double segment_mm2 = 1600.0 * std::acos(35.0 / 40.0) - 35.0 * std::sqrt(1600.0 - 1225.0);
+  EXPECT_NEAR(e->volume_mm3, segment_mm2 * 5.0, 0.01 * segment_mm2 * 5.0);
+  EXPECT_NEAR(e->depth_mm, 5.0, 0.1);
+  EXPECT_EQ(count_kind(r.events, verify::EventKind::HolderInMaterial), 0u);
+  EXPECT_EQ(count_kind(r.events, verify::EventKind::ShankInMaterial), 0u);
+  EXPECT_NEAR(r.removed_volume_mm3, 0.0, 1e-9);  // the tool cuts nothing
+
+  const app::BatchResult clear = run(p, program("-45"));
+  EXPECT_EQ(count_kind(clear.events, verify::EventKind::SpindleNoseInMaterial), 0u);
+  const app::BatchResult off = run(program("-35"));
+  EXPECT_EQ(count_kind(off.events, verify::EventKind::SpindleNoseInMaterial), 0u);
 }

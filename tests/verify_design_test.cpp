@@ -4,12 +4,17 @@
 // through along X, which the program below cuts exactly with seven passes.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <mutex>
+
+#include <nlohmann/json.hpp>
 
 #include "app/batch.hpp"
+#include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "design_test_util.hpp"
@@ -193,4 +198,69 @@ TEST(StlReader, RegressionNonFiniteOrHugeVerticesAreRefused) {
               std::string::npos)
         << e.what();
   }
+}
+
+// `lbrsim run --design` (docs/verification.md#live-design): the emulator streams the over-cut
+// program as fast as possible and the final stock is compared by the batch runner's
+// comparison: the same gouge (150 mm3 analytic) and depth as batch, within 1 %, a
+// design-gouge event (not attributed to a line: live mode keeps no move list), and the
+// deviation.csv / metrics.json keys that batch writes.
+TEST(DesignCompare, RunComparesTheFinalStockLikeBatch) {
+  const std::string stl = write_temp("lbr_design_live.stl", verify::stl_binary(kPart));
+  const std::string program = write_temp("lbr_design_live.ngc", slot_program(55.3));
+  const app::BatchResult b = run_with_design(slot_program(55.3), stl);
+  ASSERT_TRUE(b.design.has_value());
+  app::Profile p = app::default_profile();
+  p.design = {stl, 0.02};
+  app::LiveOptions o;
+  o.source = "emulator:" + program;
+  // Paced (not --speed 0, which can end before the first 50 ms snapshot on a fast machine):
+  // the run lasts a few tenths of a second, so several periodic comparisons happen.
+  o.speed = 50.0;
+  std::size_t sliced_levels = 0;
+  o.on_design = [&](const std::vector<geom::Paths>& d) { sliced_levels = d.size(); };
+  // Snapshots every 50 ms: each is compared on the writer's thread; the gouge only grows.
+  p.live.snapshot_s = 0.05;
+  o.snapshot_dir = (std::filesystem::temp_directory_path() / "lbr_design_live_snap").string();
+  std::mutex mu;
+  std::vector<double> periodic_gouge;
+  double final_gouge = -1;
+  o.on_design_report = [&](const verify::DesignReport& d, bool final) {
+    const std::lock_guard<std::mutex> lock(mu);
+    if (final) final_gouge = d.gouge_mm3;
+    else periodic_gouge.push_back(d.gouge_mm3);
+  };
+  const std::atomic<bool> stop{false};
+  const app::LiveResult r = app::run_live(p, o, stop);
+  EXPECT_GE(periodic_gouge.size(), 1u);
+  for (std::size_t k = 1; k < periodic_gouge.size(); ++k) EXPECT_LE(periodic_gouge[k - 1], periodic_gouge[k] + 1e-6);
+  if (!periodic_gouge.empty()) {
+    EXPECT_LE(periodic_gouge.back(), final_gouge + 1e-6);
+  }
+  EXPECT_EQ(sliced_levels, static_cast<std::size_t>(r.solid.levels()));
+  ASSERT_TRUE(r.design.has_value());
+  const verify::DesignReport& d = *r.design;
+  const double expected = 0.3 * 100.0 * 5.0;
+  EXPECT_NEAR(d.gouge_mm3, expected, 0.02 * expected);
+  EXPECT_NEAR(d.gouge_mm3, b.design->gouge_mm3, 0.01 * b.design->gouge_mm3);
+  EXPECT_NEAR(d.max_gouge_mm, b.design->max_gouge_mm, 0.01 * 0.3);
+  EXPECT_NEAR(d.max_gouge_at.y, 60.3, 0.01);
+  EXPECT_NEAR(d.excess_mm3, b.design->excess_mm3, 1.0);
+  EXPECT_EQ(d.levels.size(), b.design->levels.size());
+  EXPECT_EQ(d.gouge_line, 0);
+  ASSERT_EQ(r.events.size(), 1u) << verify::describe(r.events.at(1));
+  EXPECT_EQ(r.events[0].kind, verify::EventKind::DesignGouge);
+  EXPECT_DOUBLE_EQ(r.events[0].volume_mm3, d.gouge_mm3);
+  EXPECT_DOUBLE_EQ(final_gouge, d.gouge_mm3);
+  const std::string dir = (std::filesystem::temp_directory_path() / "lbr_design_live_out").string();
+  app::write_live_outputs(dir, r, p);
+  std::ifstream csv(dir + "/deviation.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "level,z_mm,gouge_mm3,excess_mm3,max_gouge_mm,max_excess_mm");
+  const nlohmann::json j = nlohmann::json::parse(app::live_metrics_json(r, p));
+  EXPECT_DOUBLE_EQ(j.at("design_gouge_mm3").get<double>(), d.gouge_mm3);
+  EXPECT_DOUBLE_EQ(j.at("max_gouge_mm").get<double>(), d.max_gouge_mm);
+  EXPECT_EQ(j.at("events").at(0).at("kind"), "design-gouge");
+  EXPECT_EQ(j.at("event_errors"), 1);
 }

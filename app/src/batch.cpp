@@ -26,7 +26,7 @@ double distance(const nc::AxisVector& a, const nc::AxisVector& b) {
 // is checked against the stock before it is subtracted and ends early where a move meets
 // material (verify/collision.hpp), so every event sees the stock of its moment.
 void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& moves, BatchResult& r, const Progress& progress,
-               verify::CollisionChecker* checker = nullptr) {
+               verify::CollisionChecker* checker = nullptr, std::span<const std::uint8_t> rapid = {}) {
   geom::ParallelSubtractor pool(profile.threads);
   r.threads = pool.threads();
   const auto t0 = std::chrono::steady_clock::now();
@@ -90,7 +90,8 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
     // One batch at a time: the checks read the stock between batches.
     std::vector<geom::SweepRef> batch;
     while (begin < moves.size()) {
-      const std::size_t end = checker->check(r.solid, moves, begin, std::min(begin + per, moves.size()), r.events);
+      const std::size_t end =
+          checker->check(r.solid, moves, rapid, begin, std::min(begin + per, moves.size()), r.events, true);
       fill(begin, end, batch);
       begin += cut_loops(batch, begin);
       const geom::SubtractStats s = pool.subtract(r.solid, batch);
@@ -103,22 +104,27 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   if (progress) progress(1.0);
 }
 
-// --design: the model read, checked and sliced before the run, so its errors come first.
-std::vector<geom::Paths> design_sections(const Profile& profile, const geom::LbrSolid& solid) {
-  if (profile.design.stl_path.empty()) return {};
-  const verify::StlMesh mesh = verify::read_stl(profile.design.stl_path);
-  verify::check_design(mesh, solid, profile.design.stl_path);
-  return verify::slice_design(mesh, solid);
-}
-
 // --design: the final stock against the design, and the move that made the deepest gouge.
 void compare_design(const Profile& profile, const std::vector<geom::Paths>& design,
                     const std::vector<motion::TimedSweep>& moves, const verify::MoveIndex& index, BatchResult& r) {
   if (profile.design.stl_path.empty()) return;
-  r.design = verify::compare_design(design, r.solid, profile.design.tolerance_mm);
-  verify::attribute_gouge(*r.design, r.solid, moves, index);
+  r.design = compare_with_design(profile, design, r.solid, moves, index, r.events);
   r.design_sections = design;
-  if (auto e = verify::gouge_event(*r.design, profile.design.tolerance_mm)) r.events.push_back(std::move(*e));
+}
+
+// --sampled: which moves are rapids. A sampled stream has no G0, so, as in live mode, a move
+// is a rapid when its sample speed (the segment's feed) is above the profile's max cutting
+// feed by more than verify::kFastMargin (docs/verification.md "batch --sampled").
+std::vector<std::uint8_t> sampled_rapids(const Profile& profile, const std::vector<motion::TimedSweep>& moves,
+                                         const verify::MoveIndex& index) {
+  const double fast = verify::kFastMargin * verify::rapid_threshold_mm_per_min(profile.machine.max_feed_mm_per_min,
+                                                                               profile.machine.rapid_mm_per_min);
+  std::vector<std::uint8_t> rapid(moves.size(), 0);
+  for (std::size_t i = 0; i < moves.size(); ++i) {
+    const nc::Segment* seg = index.find(moves[i].ref.id, nullptr);
+    rapid[i] = seg != nullptr && seg->kind == nc::SegmentKind::Feed && seg->feed_mm_per_min > fast ? 1 : 0;
+  }
+  return rapid;
 }
 
 // over-travel: from the tool path alone, before the cut (its events come first).
@@ -128,6 +134,22 @@ void check_travel(const Profile& profile, const nc::Toolpath& path, int channel,
 }
 
 }  // namespace
+
+std::vector<geom::Paths> load_design(const Profile& profile, const geom::LbrSolid& solid) {
+  if (profile.design.stl_path.empty()) return {};
+  const verify::StlMesh mesh = verify::read_stl(profile.design.stl_path);
+  verify::check_design(mesh, solid, profile.design.stl_path);
+  return verify::slice_design(mesh, solid);
+}
+
+verify::DesignReport compare_with_design(const Profile& profile, const std::vector<geom::Paths>& design,
+                                         const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
+                                         const verify::MoveIndex& index, std::vector<verify::Event>& events) {
+  verify::DesignReport d = verify::compare_design(design, solid, profile.design.tolerance_mm);
+  if (!moves.empty()) verify::attribute_gouge(d, solid, moves, index);
+  if (auto e = verify::gouge_event(d, profile.design.tolerance_mm)) events.push_back(std::move(*e));
+  return d;
+}
 
 std::vector<std::string> toolpath_warnings(const nc::Toolpath& path) {
   std::vector<std::string> out;
@@ -170,7 +192,7 @@ geom::SolidSpec batch_solid_spec(const Profile& profile, const motion::ToolTable
   return spec;
 }
 
-BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress) {
+BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress, bool sampled) {
   motion::ToolTable tools(profile.tooling, profile.solid.chord_tol_mm, profile.source);
   tools.require_path(path);
   BatchResult r{geom::LbrSolid(batch_solid_spec(profile, tools)), 0, 0, 0, 0, 0, {}, 1, {}, {}};
@@ -181,9 +203,10 @@ BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Pr
   verify::MoveIndex index;
   index.add(path, 0);
   check_travel(profile, path, 0, 0, r);
-  const std::vector<geom::Paths> design = design_sections(profile, r.solid);
+  const std::vector<geom::Paths> design = load_design(profile, r.solid);
   verify::CollisionChecker checker(profile.checks, tools, index);
-  run_moves(profile, moves, r, progress, profile.checks.enabled ? &checker : nullptr);
+  const std::vector<std::uint8_t> rapid = sampled ? sampled_rapids(profile, moves, index) : std::vector<std::uint8_t>{};
+  run_moves(profile, moves, r, progress, profile.checks.enabled ? &checker : nullptr, rapid);
   compare_design(profile, design, moves, index, r);
   return r;
 }
@@ -205,7 +228,7 @@ BatchResult run_batch_channels(const Profile& profile, const std::vector<Channel
     check_travel(profile, path, static_cast<int>(k), base, r);
     base += static_cast<geom::MoveId>(path.segments.size());
   }
-  const std::vector<geom::Paths> design = design_sections(profile, r.solid);
+  const std::vector<geom::Paths> design = load_design(profile, r.solid);
   verify::CollisionChecker checker(profile.checks, tools, index);
   run_moves(profile, plan.sweeps, r, progress, profile.checks.enabled ? &checker : nullptr);
   compare_design(profile, design, plan.sweeps, index, r);

@@ -109,6 +109,7 @@ std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   j["check_p50_ms"] = r.check_p50_ms;
   j["check_p99_ms"] = r.check_p99_ms;
   j["check_max_ms"] = r.check_max_ms;
+  if (r.design) put_design_json(*r.design, profile, j);
   return j.dump(2) + "\n";
 }
 
@@ -119,6 +120,7 @@ void write_live_outputs(const std::string& dir, const LiveResult& r, const Profi
   write_file((std::filesystem::path(dir) / "metrics.json").string(), live_metrics_json(r, profile));
   write_file((std::filesystem::path(dir) / "levels.lbrs").string(), geom::to_bytes(r.solid));
   write_file((std::filesystem::path(dir) / "events.csv").string(), verify::events_csv(r.events));
+  if (r.design) write_file((std::filesystem::path(dir) / "deviation.csv").string(), verify::deviation_csv(*r.design));
 }
 
 nc::EmulatorLimits live_emulator_limits(const Profile& profile) {

@@ -144,6 +144,12 @@ gfx::CaptureOptions capture_options(const BatchOptions& o) {
   return cap;
 }
 
+// --color deviation shows the deviation from --design: without one it is an error.
+void require_design_for_deviation(const std::string& color, const std::string& design) {
+  if (color == "deviation" && design.empty())
+    throw std::runtime_error("--color deviation needs --design FILE.stl: the design model whose deviation it shows");
+}
+
 // --color deviation: colours from the design the run compared with (docs/verification.md#deviation-colour).
 bool deviation_colours(const BatchOptions& o) { return o.color == "deviation"; }
 
@@ -165,15 +171,8 @@ constexpr int kExitEvents = 3;
 constexpr std::size_t kEventsShown = 20;
 
 // --design: one line with the comparison's figures.
-void report_design(const app::BatchResult& r, const BatchOptions& o) {
-  if (!r.design) return;
-  const verify::DesignReport& d = *r.design;
-  std::printf("design: gouge %.3f mm3, max %.3f mm", d.gouge_mm3, d.max_gouge_mm);
-  if (d.max_gouge_level >= 0)
-    std::printf(" at X%.3f Y%.3f Z%.3f (%s:%d)", d.max_gouge_at.x, d.max_gouge_at.y, d.max_gouge_at.z,
-                d.gouge_source.c_str(), d.gouge_line);
-  std::printf(" | excess %.3f mm3, max %.3f mm beyond %.3f mm (%s)\n", d.excess_mm3, d.max_excess_mm,
-              o.design_tolerance, out_file(o.out, "deviation.csv").c_str());
+void print_design(const verify::DesignReport& d, double tolerance_mm, const std::string& out) {
+  std::printf("design: %s (%s)\n", app::design_summary(d, tolerance_mm).c_str(), out_file(out, "deviation.csv").c_str());
 }
 
 // The checks' summary line and the first events; returns kExitEvents when --fail-on says so.
@@ -187,7 +186,7 @@ int report_events(const app::BatchResult& r, const BatchOptions& o) {
     else spdlog::warn("{}", verify::describe(e));
   }
   if (r.events.size() > kEventsShown) spdlog::warn("{} more events in {}", r.events.size() - kEventsShown, out_file(o.out, "events.csv"));
-  report_design(r, o);
+  if (r.design) print_design(*r.design, o.design_tolerance, o.out);
   const bool fail = (o.fail_on == "error" && c.errors > 0) || (o.fail_on == "warning" && c.errors + c.warnings > 0);
   return fail ? kExitEvents : 0;
 }
@@ -261,6 +260,7 @@ gfx::RenderThreadConfig render_config(const BatchOptions& o, const ViewCliOption
 }
 
 int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
+  require_design_for_deviation(o.color, o.design);
   if (!gfx::display_available())
     throw gfx::DisplayError("lbrsim view needs a display (DISPLAY / WAYLAND_DISPLAY are not set); "
                             "headless: `xvfb-run -a lbrsim view --hidden ...`");
@@ -290,8 +290,7 @@ int run_view_command(const BatchOptions& o, const ViewCliOptions& v) {
 
 int run_batch_command(const BatchOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::warn);  // --quiet: the result lines and warnings only
-  if (deviation_colours(o) && o.design.empty())
-    throw std::runtime_error("--color deviation needs --design FILE.stl: the design model whose deviation it shows");
+  require_design_for_deviation(o.color, o.design);
   const app::Profile profile = batch_profile(o);
   const gfx::CaptureOptions cap = capture_options(o);
   if (!profile.channels.empty()) return run_channels_command(o, profile, cap);
@@ -316,7 +315,7 @@ int run_batch_command(const BatchOptions& o) {
   if (!o.quiet) {
     progress = [](double f) { spdlog::info("progress {:5.1f} %", 100.0 * f); };
   }
-  app::BatchResult r = app::run_batch(profile, path, progress);
+  app::BatchResult r = app::run_batch(profile, path, progress, o.sampled);
   if (emulated) r.machining_time_s = emulated_time_s;
   app::write_batch_outputs(o.out, r, profile, program);
   print_result(r, o);
@@ -339,6 +338,8 @@ struct RunOptions {
   // power-loss resume (docs/snapshot.md)
   bool resume = false;
   std::string snapshot_dir;  // empty: the --out folder
+  std::string design;              // --design: STL of the part to compare the final stock with
+  double design_tolerance = 0.02;  // --tolerance [mm]
 };
 
 // The render thread of a rendered run, for the watchdog's probe (null when none runs).
@@ -409,11 +410,15 @@ gfx::RenderThreadConfig live_render_config(const RunOptions& o, const app::Profi
   return rc;
 }
 
-// metrics.json, levels.lbrs and the mesh files of a finished (or stopped) live run.
-void write_live_results(const RunOptions& o, const app::Profile& profile, const app::LiveResult& r) {
+// metrics.json, levels.lbrs and the mesh files of a finished (or stopped) live run; with
+// --color deviation the PLY carries the deviation from the design sections.
+void write_live_results(const RunOptions& o, const app::Profile& profile, const app::LiveResult& r,
+                        const std::vector<geom::Paths>& design) {
   try {
     app::write_live_outputs(o.out, r, profile);
-    app::write_mesh_files(r.solid, o.stl, o.ply);
+    app::DeviationColours colours;
+    if (o.color == "deviation" && !design.empty()) colours = {&design, o.design_tolerance};
+    app::write_mesh_files(r.solid, o.stl, o.ply, colours);
   } catch (...) {
     g_results.store(Results::Failed);
     throw;
@@ -445,6 +450,12 @@ class HudNotice {
     rt_ = rt;
     push();
   }
+  // The design comparison's line (--design), shown when the run has ended.
+  void set_design(const std::string& text) {
+    std::lock_guard lock(mu_);
+    design_ = text;
+    push();
+  }
   void set(const std::string& text) {
     std::lock_guard lock(mu_);
     text_.clear();
@@ -463,17 +474,23 @@ class HudNotice {
 
  private:
   void push() {
-    if (rt_ != nullptr && !text_.empty()) rt_->edit([&](gfx::Camera&, gfx::RenderOptions& ro) { ro.notice = text_; });
+    if (rt_ == nullptr || (text_.empty() && design_.empty())) return;
+    rt_->edit([&](gfx::Camera&, gfx::RenderOptions& ro) {
+      ro.notice = text_;
+      ro.design = design_;
+    });
   }
   std::mutex mu_;
   gfx::RenderThread* rt_ = nullptr;
-  std::string text_;
+  std::string text_, design_;
 };
 
 // The live run on its own thread while the main thread owns the window's events and the
 // render thread draws what the geometry thread publishes.
-app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profile, const app::StatusFn& status) {
-  const gfx::RenderThreadConfig rc = live_render_config(o, profile);
+// `design`: filled by o.live.on_design before the initial solid arrives (--design).
+app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profile, const app::StatusFn& status,
+                                  const std::vector<geom::Paths>& design) {
+  gfx::RenderThreadConfig rc = live_render_config(o, profile);
   const bool visible = !o.hidden && !o.no_window;
   gfx::Window win(rc.width, rc.height, visible, "lbrsim run — " + o.live.source, o.kiosk);
   gfx::SolidExchange ex(1 << 14);
@@ -485,6 +502,10 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
     if (warn) warn(w);
     notice.set(w);
   };
+  // --design: the figures on the HUD, at every snapshot and when the run ends.
+  lo.on_design_report = [&notice, tol = o.design_tolerance](const verify::DesignReport& d, bool final) {
+    notice.set_design(app::design_summary(d, tol) + (final ? " (final)" : " (at the last snapshot)"));
+  };
   lo.exchange = &ex;
   lo.on_start = [&initial](const geom::LbrSolid& s) { initial.set_value(std::make_unique<geom::LbrSolid>(s)); };
   std::optional<app::LiveResult> result;
@@ -493,7 +514,7 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
   std::thread live([&] {
     try {
       result.emplace(app::run_live(profile, lo, g_stop, status));
-      write_live_results(o, profile, *result);  // before anything that needs the display
+      write_live_results(o, profile, *result, design);  // before anything that needs the display
     } catch (...) {
       Results running = Results::Running;
       g_results.compare_exchange_strong(running, Results::Failed);
@@ -507,8 +528,11 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
   });
   std::unique_ptr<geom::LbrSolid> start = initial_ready.get();
   if (start) {
+    // --color deviation: the colours from the design sections on the stock's levels (kept in `start`).
+    if (rc.render.color == gfx::ColorMode::Deviation && !design.empty())
+      rc.render.deviation = app::deviation_fn(design, *start, o.design_tolerance);
     gfx::RenderThread rt(win, ex, *start, rc);
-    start.reset();
+    if (!rc.render.deviation) start.reset();
     rt.start();
     set_render_thread(&rt);
     notice.attach(&rt);
@@ -545,6 +569,7 @@ void print_live_summary(const RunOptions& o, const app::LiveResult& r) {
               r.rt_mode.c_str(), g_signalled.load() ? " | stopped by signal" : (g_window_closed.load() ? " | stopped: window closed" : ""));
   std::printf("wrote %s and %s%s%s%s%s\n", out_file(o.out, "metrics.json").c_str(), out_file(o.out, "levels.lbrs").c_str(),
               o.stl.empty() ? "" : ", ", o.stl.c_str(), o.ply.empty() ? "" : ", ", o.ply.c_str());
+  if (r.design) print_design(*r.design, o.design_tolerance, o.out);
 }
 
 // --resume: the newest valid snapshot in the snapshot folder (a corrupt one is reported and
@@ -579,7 +604,9 @@ std::vector<app::ProgressProbe> live_probes(const app::LiveProgress& pr) {
 
 int run_live_command(RunOptions o) {
   o.live.on_warning = [](const std::string& w) { spdlog::warn("{}", w); };
-  const app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+  require_design_for_deviation(o.color, o.design);
+  app::Profile profile = o.profile.empty() ? app::default_profile() : app::load_profile(o.profile);
+  profile.design = {o.design, o.design_tolerance};
   install_stop_handlers();
   spdlog::info("run: source {}, profile {}, period {} ms", o.live.source, profile.source, profile.live.period_ms);
   o.live.snapshot_dir = o.snapshot_dir.empty() ? o.out : o.snapshot_dir;
@@ -604,19 +631,21 @@ int run_live_command(RunOptions o) {
     throw gfx::DisplayError("--screenshot-every needs an X or Wayland display for its hidden OpenGL window, and "
                             "neither DISPLAY nor WAYLAND_DISPLAY is set. Run it under a virtual X server: "
                             "`xvfb-run -a lbrsim run ...`");
+  std::vector<geom::Paths> design;  // --design: the model's sections (deviation colours of the view and the PLY)
+  o.live.on_design = [&design](const std::vector<geom::Paths>& d) { design = d; };
   g_results_dir.store(o.out.c_str());
   g_results.store(Results::Running);
   if (want_render) {
     gfx::set_display_lost_handler(on_display_lost);
     if (o.screenshot_prefix.empty()) std::filesystem::create_directories(o.out);  // screenshots go there
-    const app::LiveResult r = run_live_rendered(o, profile, status);  // writes the results itself
+    const app::LiveResult r = run_live_rendered(o, profile, status, design);  // writes the results itself
     notifier.notify("STOPPING=1");
     print_live_summary(o, r);
     return 0;
   }
   const app::LiveResult r = app::run_live(profile, o.live, g_stop, status);
   notifier.notify("STOPPING=1");
-  write_live_results(o, profile, r);
+  write_live_results(o, profile, r, design);
   print_live_summary(o, r);
   return 0;
 }
@@ -633,6 +662,16 @@ void add_render_options(CLI::App* c, BatchOptions& o) {
   c->add_option("--size", o.size, "Image / window size WxH [px]")->capture_default_str();
 }
 
+// --design FILE.stl / --tolerance MM (batch, view, run): the design-model comparison.
+void add_design_options(CLI::App* c, std::string& design, double& tolerance_mm, const char* what) {
+  c->add_option("--design", design, std::string("Compare ") + what +
+                                        " with this design model (STL, mm, work coordinates; docs/verification.md)")
+      ->check(CLI::ExistingFile);
+  c->add_option("--tolerance", tolerance_mm, "--design: stock closer than this outside the design is not excess [mm]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
 CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
   CLI::App* batch = cli.add_subcommand("batch", "Run a part program through the simulator as fast as possible");
   batch->add_option("--program", b.program,
@@ -646,7 +685,7 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
   add_start_tool_option(batch, b.start_tool);
   batch->add_flag("--sampled", b.sampled,
                   "Run the kernel on the machine emulator's sampled stream (as live mode sees it) instead of the "
-                  "interpreted segments");
+                  "interpreted segments; the checks tell rapids by sample speed, as live mode does");
   batch->add_option("--profile", b.profile, "Machine profile (TOML); default: the built-in 3-axis mill profile");
   batch->add_option("--stock", b.stock,
                     "Override the stock: box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX or cylinder:DIAMETER,ZMIN,ZMAX [mm]");
@@ -673,11 +712,7 @@ CLI::App* add_batch_command(CLI::App& cli, BatchOptions& b) {
       ->check(CLI::IsMember({"never", "error", "warning"}))
       ->capture_default_str();
   batch->add_flag("--no-checks", b.no_checks, "Skip the collision and process checks (profile [checks] enabled = false)");
-  batch->add_option("--design", b.design, "Compare the final stock with this design model (STL, mm, work coordinates)")
-      ->check(CLI::ExistingFile);
-  batch->add_option("--tolerance", b.design_tolerance, "--design: stock closer than this outside the design is not excess [mm]")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+  add_design_options(batch, b.design, b.design_tolerance, "the final stock");
   return batch;
 }
 
@@ -697,6 +732,7 @@ CLI::App* add_view_command(CLI::App& cli, BatchOptions& vb, ViewCliOptions& vv) 
   view->add_flag("--quiet", vb.quiet, "Fewer messages");
   add_render_options(view, vb);
   view->add_flag("--no-tool", vb.no_tool, "Do not draw the tool (key K toggles it)");
+  add_design_options(view, vb.design, vb.design_tolerance, "the final stock (with --animate: colours as it goes)");
   view->add_flag("--animate", vv.animate, "Stream the program through the kernel in real time (geometry thread)");
   view->add_option("--speed", vv.speed, "Simulated seconds per second when animating")->check(CLI::Range(0.01, 1000.0));
   view->add_option("--rate", vv.rate_hz, "Render rate [Hz]")->check(CLI::Range(1.0, 240.0))->capture_default_str();
@@ -750,10 +786,12 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
   run->add_option("--view", ro.view, "Camera: top, front, side or iso")
       ->check(CLI::IsMember({"top", "front", "side", "iso"}))
       ->capture_default_str();
-  run->add_option("--color", ro.color, "Colour mode: plain, heat or regions")
-      ->check(CLI::IsMember({"plain", "heat", "regions"}))
+  run->add_option("--color", ro.color, "Colour mode: plain, heat, regions or deviation (from --design: gouge red, "
+                  "excess blue)")
+      ->check(CLI::IsMember({"plain", "heat", "regions", "deviation"}))
       ->capture_default_str();
   run->add_option("--size", ro.size, "Window / screenshot size WxH [px]")->capture_default_str();
+  add_design_options(run, ro.design, ro.design_tolerance, "the final stock (when the run ends)");
   run->add_option("--render-rate", ro.rate_hz, "Render rate [Hz] (default: the profile's [render] rate_hz, 30)")
       ->check(CLI::Range(1.0, 240.0));
   return run;

@@ -83,10 +83,22 @@ std::vector<ChannelPath> load_channel_paths(const Profile& profile, Interpreter 
 
 nc::Toolpath demo_toolpath() { return nc::parse_movelist(kDemoProgram, "<built-in demo-pocket.moves>"); }
 
-namespace {
+std::string design_summary(const verify::DesignReport& d, double tolerance_mm) {
+  char buf[512];
+  int n = std::snprintf(buf, sizeof buf, "gouge %.3f mm3, max %.3f mm", d.gouge_mm3, d.max_gouge_mm);
+  if (d.max_gouge_level >= 0 && n > 0 && n < static_cast<int>(sizeof buf)) {
+    n += std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), " at X%.3f Y%.3f Z%.3f", d.max_gouge_at.x,
+                       d.max_gouge_at.y, d.max_gouge_at.z);
+    if (d.gouge_line > 0 && n > 0 && n < static_cast<int>(sizeof buf))
+      n += std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), " (%s:%d)", d.gouge_source.c_str(), d.gouge_line);
+  }
+  if (n > 0 && n < static_cast<int>(sizeof buf))
+    std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), " | excess %.3f mm3, max %.3f mm beyond %.3f mm",
+                  d.excess_mm3, d.max_excess_mm, tolerance_mm);
+  return buf;
+}
 
-// --design: the comparison's keys of metrics.json (docs/formats.md#metrics-design).
-void design_json(const verify::DesignReport& d, const Profile& profile, nlohmann::json& j) {
+void put_design_json(const verify::DesignReport& d, const Profile& profile, nlohmann::json& j) {
   j["design"] = profile.design.stl_path;
   j["design_tolerance_mm"] = profile.design.tolerance_mm;
   j["design_volume_mm3"] = d.design_volume_mm3;
@@ -100,6 +112,8 @@ void design_json(const verify::DesignReport& d, const Profile& profile, nlohmann
   j["max_gouge_source"] = d.gouge_source;
   j["max_gouge_line"] = d.gouge_line;
 }
+
+namespace {
 
 // The events as metrics.json's "events" array (fields as the columns of events.csv).
 nlohmann::json events_json(const std::vector<verify::Event>& events) {
@@ -172,7 +186,7 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
   j["event_errors"] = counts.errors;
   j["event_warnings"] = counts.warnings;
   j["events"] = events_json(r.events);
-  if (r.design) design_json(*r.design, profile, j);
+  if (r.design) put_design_json(*r.design, profile, j);
   return j.dump(2) + "\n";
 }
 

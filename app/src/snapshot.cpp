@@ -226,8 +226,8 @@ LoadedSnapshot load_newest_snapshot(const std::string& dir) {
   return out;
 }
 
-SnapshotWriter::SnapshotWriter(std::string dir, std::uint64_t first_generation)
-    : dir_(std::move(dir)), generation_(first_generation) {
+SnapshotWriter::SnapshotWriter(std::string dir, std::uint64_t first_generation, AfterWrite after_write)
+    : dir_(std::move(dir)), generation_(first_generation), after_write_(std::move(after_write)) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw std::runtime_error(dir_ + ": cannot create the snapshot folder: " + ec.message());
@@ -262,6 +262,7 @@ void SnapshotWriter::loop() {
   for (;;) {
     if (state_.load(std::memory_order_acquire) == kFilled) {
       write(slot_);
+      if (after_write_) after_write_(slot_);
       state_.store(kFree, std::memory_order_release);
       continue;
     }

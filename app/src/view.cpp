@@ -5,10 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 
 #include <spdlog/spdlog.h>
 
+#include "app/outputs.hpp"
 #include "gfx/viewer.hpp"
 #include "gfx/window.hpp"
 
@@ -221,10 +223,18 @@ void PathStreamer::loop() {
 
 namespace {
 
-// The batch result with the tool at its final pose and the programmed path (segment ends).
+struct ViewDesign {
+  std::optional<verify::DesignReport> report;  // a static view's comparison
+  std::vector<geom::Paths> sections;            // the model sliced on the stock's levels
+};
+
+// The batch result with the tool at its final pose and the programmed path (segment ends);
+// with --design, the comparison and the design sections go to `design`.
 std::unique_ptr<geom::LbrSolid> publish_batch_result(const Profile& profile, const std::vector<ChannelPath>& channels,
-                                                     gfx::SolidExchange& ex) {
+                                                     gfx::SolidExchange& ex, ViewDesign& design) {
   BatchResult r = channels.size() == 1 ? run_batch(profile, channels.front().path) : run_batch_channels(profile, channels);
+  design.report = std::move(r.design);
+  design.sections = std::move(r.design_sections);
   auto solid = std::make_unique<geom::LbrSolid>(std::move(r.solid));
   solid->clear_dirty();
   std::size_t segments = 0;
@@ -238,6 +248,18 @@ std::unique_ptr<geom::LbrSolid> publish_batch_result(const Profile& profile, con
   const auto tools = channels.size() == 1 ? final_tools(profile, channels.front().path) : std::vector<gfx::ToolState>{};
   (void)ex.publish(*solid, tools, static_cast<geom::MoveId>(segments), gfx::LiveStats{});
   return solid;
+}
+
+// --design: deviation colours (--color deviation) from the sections on the levels of `solid`,
+// and the comparison's line on the HUD and stdout (a static view; --animate colours only).
+void apply_design(const Profile& profile, const ViewDesign& design, const geom::LbrSolid& solid,
+                  gfx::RenderThreadConfig& rc) {
+  const double tol = profile.design.tolerance_mm;
+  if (rc.render.color == gfx::ColorMode::Deviation && !design.sections.empty())
+    rc.render.deviation = deviation_fn(design.sections, solid, tol);
+  if (!design.report) return;
+  rc.render.design = design_summary(*design.report, tol);
+  std::printf("design: %s\n", rc.render.design.c_str());
 }
 
 }  // namespace
@@ -262,6 +284,7 @@ int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, c
   std::size_t segments = 0;
   for (const ChannelPath& c : channels) segments += c.path.segments.size();
   std::unique_ptr<geom::LbrSolid> solid;
+  ViewDesign design;  // --design; outlives the render thread (its deviation callback reads it)
   gfx::SolidExchange ex(std::max<std::size_t>(8192, segments + 2 * channels.size()));
   std::unique_ptr<PathStreamer> streamer;
   gfx::ReplayControl replay;
@@ -277,10 +300,12 @@ int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, c
       rc.ui.replay = &replay;
     }
     streamer = std::make_unique<PathStreamer>(profile, channels, *solid, ex, so);
+    design.sections = load_design(profile, *solid);
     if (!opt.quiet) spdlog::info("streaming {:.1f} s of machining at {}x", streamer->duration_s(), opt.stream.speed);
   } else {
-    solid = publish_batch_result(profile, channels, ex);
+    solid = publish_batch_result(profile, channels, ex, design);
   }
+  apply_design(profile, design, *solid, rc);
 
   gfx::RenderThread rt(win, ex, *solid, rc);
   rt.start();

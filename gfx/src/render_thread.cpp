@@ -136,6 +136,7 @@ void RenderThread::sync(Renderer& ren, Camera& cam, int& w, int& h) {
   o.section_mm = opt_.section_mm;
   o.section_flip = opt_.section_flip;
   if (o.notice != opt_.notice) o.notice = opt_.notice;
+  if (o.design != opt_.design) o.design = opt_.design;
   w = w_;
   h = h_;
   if (ui_ != nullptr) ui_->feed(events_);

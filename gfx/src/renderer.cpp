@@ -660,6 +660,10 @@ void Renderer::draw_hud(int w, int h) {
     const std::size_t used = std::strlen(buf);
     std::snprintf(buf + used, sizeof buf - used, "WARNING: %s\n", opt_.notice.c_str());
   }
+  if (!opt_.design.empty()) {
+    const std::size_t used = std::strlen(buf);
+    std::snprintf(buf + used, sizeof buf - used, "DESIGN: %s\n", opt_.design.c_str());
+  }
   gl_->hud->draw(buf, w, h);
   draw_alarms(w, h);
 }

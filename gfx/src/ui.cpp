@@ -161,6 +161,7 @@ void Ui::status_bar(const Renderer& ren, const UiFrameInput& in) {
     status_line_source(ren);
     status_line_machining(ren);
     alarms_line(L, in.opt.notice);
+    if (!in.opt.design.empty()) flow(kGrey, "DESIGN: %s", in.opt.design.c_str());
     remember_window();
     status_h_ = ImGui::GetWindowSize().y;
   }

@@ -112,6 +112,10 @@ Toolpath sampled_toolpath(const Toolpath& path, const EmulatorLimits& limits) {
     seg.end = s.axes;
     seg.tool = s.tool;
     seg.line = plans.empty() ? 0 : plans[plan].line;
+    if (!plans.empty()) {
+      seg.spindle = plans[plan].spindle;
+      seg.spindle_s = plans[plan].spindle_s;
+    }
     if (s.tool != tool) {
       seg.kind = SegmentKind::ToolChange;
       tool = s.tool;

@@ -252,6 +252,8 @@ Plan base_plan(const Move& m, PieceKind kind) {
   p.kind = kind;
   p.tool = m.seg->tool;
   p.line = m.seg->line;
+  p.spindle = m.seg->spindle;
+  p.spindle_s = m.seg->spindle_s;
   return p;
 }
 

@@ -8,6 +8,14 @@ namespace lbr::verify {
 
 namespace {
 
+// The kinds of the parts that do not cut (shank, holder, spindle nose): the only ones a run
+// may continue with (CollisionChecker::check_moves()). A cutting sweep's kinds (rapid,
+// spindle off, feed limit, plunge) remove what they meet, so each such move is measured
+// against the stock of its exact moment.
+constexpr unsigned kPartKinds = (1u << static_cast<unsigned>(EventKind::ShankInMaterial)) |
+                                (1u << static_cast<unsigned>(EventKind::HolderInMaterial)) |
+                                (1u << static_cast<unsigned>(EventKind::SpindleNoseInMaterial));
+
 
 geom::Pose raised(const geom::Pose& p, double h_mm) {
   return {p.tip + h_mm * p.axis, p.axis};
@@ -63,6 +71,11 @@ CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::Tool
     p.has_shank = tool.length_mm - p.shank_from_mm > 0.0;
     if (p.has_shank) p.shank = cylinder(shank_d, tool.length_mm - p.shank_from_mm, tools.chord_tol_mm());
     p.holder = cylinder(tool.holder_diameter_mm, tool.holder_length_mm, tools.chord_tol_mm());
+    p.has_nose = config.spindle_nose_diameter_mm > 0.0 && config.spindle_nose_length_mm > 0.0;
+    if (p.has_nose) {
+      p.nose_from_mm = tool.length_mm + tool.holder_length_mm + config.tolerance_mm;
+      p.nose = cylinder(config.spindle_nose_diameter_mm, config.spindle_nose_length_mm, tools.chord_tol_mm());
+    }
     p.centre_cutting = tool.centre_cutting;
     if (!p.centre_cutting)
       p.core = cylinder(kNonCuttingCoreFraction * tool.diameter_mm, tool.flute_length_mm, tools.chord_tol_mm());
@@ -83,8 +96,9 @@ int CollisionChecker::segment_findings(const geom::LbrSolid& solid, const motion
   const bool rapid = rapid_flag >= 0 ? rapid_flag > 0 : seg != nullptr && seg->kind == nc::SegmentKind::Rapid;
   const bool spindle_off = seg != nullptr && !seg->spindle_turning();
   const double feed_limit = config_.max_cutting_feed_mm_per_min;
-  const bool too_fast =
-      seg != nullptr && seg->kind == nc::SegmentKind::Feed && feed_limit > 0.0 && seg->feed_mm_per_min > feed_limit;
+  // A rapid is judged as one (a sampled rapid is a Feed segment at the rapid's speed).
+  const bool too_fast = !rapid && seg != nullptr && seg->kind == nc::SegmentKind::Feed && feed_limit > 0.0 &&
+                        seg->feed_mm_per_min > feed_limit;
   if (rapid || spindle_off || too_fast) {
     const Intrusion in =
         probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm, contact_only_);
@@ -107,17 +121,20 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
       if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
     }
   }
-  if (p.has_shank) {
-    const Intrusion in =
-        probe_.measure(solid, geom::Sweep(p.shank, raised(m.ref.from, p.shank_from_mm), raised(m.ref.to, p.shank_from_mm)),
-                       config_.tolerance_mm, contact_only_);
-    if (in.deep_mm3 > 0.0) out[n++] = {EventKind::ShankInMaterial, in};
-  }
-  const Intrusion in =
-      probe_.measure(solid, geom::Sweep(p.holder, raised(m.ref.from, p.holder_from_mm), raised(m.ref.to, p.holder_from_mm)),
-                     config_.tolerance_mm, contact_only_);
-  if (in.deep_mm3 > 0.0) out[n++] = {EventKind::HolderInMaterial, in};
+  if (p.has_shank && raised_finding(solid, m, p.shank, p.shank_from_mm, EventKind::ShankInMaterial, out[n])) ++n;
+  if (raised_finding(solid, m, p.holder, p.holder_from_mm, EventKind::HolderInMaterial, out[n])) ++n;
+  if (p.has_nose && raised_finding(solid, m, p.nose, p.nose_from_mm, EventKind::SpindleNoseInMaterial, out[n])) ++n;
   return n;
+}
+
+bool CollisionChecker::raised_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m,
+                                      const geom::CutterShape& part, double from_mm, EventKind kind, Finding& out) {
+  const Intrusion in =
+      probe_.measure(solid, geom::Sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm)), config_.tolerance_mm,
+                     contact_only_);
+  if (!(in.deep_mm3 > 0.0)) return false;
+  out = {kind, in};
+  return true;
 }
 
 Event CollisionChecker::event_of(const motion::TimedSweep& m, const Finding& f) const {
@@ -147,8 +164,8 @@ std::size_t CollisionChecker::check(const geom::LbrSolid& solid, std::span<const
 
 std::size_t CollisionChecker::check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                                     std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to,
-                                    std::vector<Event>& events) {
-  return check_moves(solid, moves, rapid, from, to, events, false);
+                                    std::vector<Event>& events, bool runs) {
+  return check_moves(solid, moves, rapid, from, to, events, runs);
 }
 
 std::size_t CollisionChecker::check_moves(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
@@ -160,12 +177,12 @@ std::size_t CollisionChecker::check_moves(const geom::LbrSolid& solid, std::span
   for (std::size_t i = from; i < to; ++i) {
     // After a move with findings, the next is first tested for contact only: if it continues
     // the run (the same kinds), it extends the run's events without adding volume or depth.
-    contact_only_ = runs && i > from && before != 0;
+    contact_only_ = runs && i > from && before != 0 && (before & ~kPartKinds) == 0;
     const int n = findings_of(solid, moves[i], rapid.empty() ? -1 : (rapid[i] != 0 ? 1 : 0), found);
     unsigned kinds = 0;
     for (int k = 0; k < n; ++k) kinds |= 1u << static_cast<unsigned>(found[k].kind);
     // A move that starts a run of findings is checked again against the stock of its moment.
-    if (n > 0 && i > from && (!runs || kinds != before)) {
+    if (n > 0 && i > from && (!runs || kinds != before || (kinds & ~kPartKinds) != 0)) {
       contact_only_ = false;
       return i;
     }

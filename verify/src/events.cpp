@@ -16,6 +16,7 @@ const char* to_string(EventKind k) noexcept {
     case EventKind::FeedLimit: return "feed-limit";
     case EventKind::OverTravel: return "over-travel";
     case EventKind::DesignGouge: return "design-gouge";
+    case EventKind::SpindleNoseInMaterial: return "spindle-nose-in-material";
   }
   return "?";
 }
@@ -30,7 +31,8 @@ Severity severity_of(EventKind k) noexcept {
     case EventKind::SpindleOff:
     case EventKind::Plunge:
     case EventKind::OverTravel:
-    case EventKind::DesignGouge: return Severity::Error;
+    case EventKind::DesignGouge:
+    case EventKind::SpindleNoseInMaterial: return Severity::Error;
     case EventKind::FeedLimit: return Severity::Warning;
   }
   return Severity::Error;
@@ -121,7 +123,7 @@ std::string describe(const Event& e) {
 void add_event(std::vector<Event>& events, const Event& e) {
   // One move can raise several kinds at once (shank and holder), so the run to extend is
   // looked for among the last few events.
-  constexpr std::size_t kKinds = 6;  // the kinds one move can raise in CollisionChecker::check()
+  constexpr std::size_t kKinds = 7;  // the kinds one move can raise in CollisionChecker::check()
   for (std::size_t back = 0; back < std::min(kKinds, events.size()); ++back) {
     Event& last = events[events.size() - 1 - back];
     const bool follows = e.move == last.last_move || e.move == last.last_move + 1;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -46,8 +47,11 @@ std::vector<std::string> toolpath_warnings(const nc::Toolpath& path);
 // when the path uses a tool the profile does not define, or (profile.design set) when the
 // design model cannot be read or compared (verify::StlError, verify::DesignError), before
 // the run. Segments with tool 0 (empty
-// spindle) remove nothing.
-[[nodiscard]] BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress = {});
+// spindle) remove nothing. `sampled`: `path` is the emulator's sampled stream
+// (nc::sampled_toolpath, `batch --sampled`), whose rapids the checks tell by speed as live
+// mode does (docs/verification.md "batch --sampled").
+[[nodiscard]] BatchResult run_batch(const Profile& profile, const nc::Toolpath& path, const Progress& progress = {},
+                                    bool sampled = false);
 
 // One channel of a multi-channel run: its name, tool path and kinematics.
 using ChannelPath = motion::ChannelPath;
@@ -61,6 +65,22 @@ using ChannelPath = motion::ChannelPath;
 // machining_time_s is the longest channel's emulated time.
 [[nodiscard]] BatchResult run_batch_channels(const Profile& profile, const std::vector<ChannelPath>& channels,
                                              bool sampled = false, const Progress& progress = {});
+
+// --design (docs/verification.md#design-model-comparison), one mechanism for batch, view and
+// run: the model of profile.design read, checked against the stock of `solid` and sliced on
+// its levels; empty when profile.design names no model. Setup; throws verify::StlError or
+// verify::DesignError naming the file.
+[[nodiscard]] std::vector<geom::Paths> load_design(const Profile& profile, const geom::LbrSolid& solid);
+
+// The final stock `solid` against `design` (load_design()): the report, its deepest gouge
+// attributed to the earliest of `moves` that cut there (empty `moves`: not attributed, as in
+// live mode, which keeps no move list), and a design-gouge event appended to `events` when
+// that gouge is deeper than the tolerance. Not real-time: allocates, takes seconds on big parts.
+[[nodiscard]] verify::DesignReport compare_with_design(const Profile& profile, const std::vector<geom::Paths>& design,
+                                                       const geom::LbrSolid& solid,
+                                                       std::span<const motion::TimedSweep> moves,
+                                                       const verify::MoveIndex& index,
+                                                       std::vector<verify::Event>& events);
 
 // The stock of `profile` with regions = auto sized for the tool with the most motions.
 [[nodiscard]] geom::SolidSpec batch_solid_spec(const Profile& profile, const motion::ToolTable& tools);

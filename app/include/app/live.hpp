@@ -16,6 +16,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,6 +27,7 @@
 #include "gfx/exchange.hpp"
 #include "nc/emulator.hpp"
 #include "nc/toolpath.hpp"
+#include "verify/design.hpp"
 #include "verify/events.hpp"
 
 namespace lbr::app {
@@ -58,6 +60,13 @@ struct LiveOptions {
   // `on_start` receives the solid before any thread starts (the render side's initial copy).
   gfx::SolidExchange* exchange = nullptr;
   std::function<void(const geom::LbrSolid&)> on_start;
+  // --design (profile.design set): receives the design model's sections on the solid's
+  // levels (app::load_design) before on_start, for the renderer's deviation colours.
+  std::function<void(const std::vector<geom::Paths>&)> on_design;
+  // --design: the comparison of the stock with the model, at every periodic snapshot (on the
+  // snapshot writer's thread, `final` false; none without snapshots) and when the run ends
+  // (`final` true, the control thread; also in LiveResult::design). For the HUD.
+  std::function<void(const verify::DesignReport&, bool final)> on_design_report;
   // Overload (docs/architecture.md "Live overload"): samples the HAL side may hold while the
   // ring is full (0: 16 × live.ring_capacity); testing: sleep this long after every kernel
   // call (a deliberately slowed kernel).
@@ -119,18 +128,26 @@ struct LiveResult {
   // Power-loss catch-up (docs/snapshot.md): samples applied at start from the --record file
   // after the snapshot's position, and recorded ones skipped there because the solid held them.
   std::uint64_t samples_caught_up = 0, catch_up_skipped = 0;
+  // --design (docs/verification.md#live-design): the final stock against the design model,
+  // compared when the run ends (control thread), the same comparison as batch; its deepest
+  // gouge is not attributed to a sample (the pipeline keeps no move list). A gouge deeper
+  // than the tolerance adds a design-gouge event to `events`.
+  std::optional<verify::DesignReport> design{};
 };
 
 using StatusFn = std::function<void(const std::string& line)>;
 
 // The pipeline's lifecycle (as ros2_control's hardware components):
-//   configure()  setup: tool shapes, stock, source opened, rings, record file; calls
-//                opt.on_start with the initial solid. Throws std::runtime_error.
+//   configure()  setup: tool shapes, stock, design model (profile.design: read, checked
+//                and sliced, errors first), source opened, rings, record file; calls
+//                opt.on_design and opt.on_start. Throws std::runtime_error.
 //   start()      starts the geometry, HAL and (with --record) recorder threads.
 //   running()    true until the geometry thread has applied the last sample.
 //   stop()       asks the source loop to end (a no-op once the source has ended), joins the
 //                threads, closes the source. Idempotent.
-//   result()     after stop() (called if needed): the final solid and counters; once.
+//   result()     after stop() (called if needed): the final solid and counters, and with
+//                profile.design the comparison with the design model (seconds on a big
+//                part); once.
 // Every call is made from one control thread. `stop` (e.g. set by a signal handler) ends the
 // source loop like stop() does.
 class LivePipeline {

@@ -41,6 +41,12 @@ std::uint64_t write_samples_csv(const std::string& path, nc::Emulator& emulator)
 // The checks' keys of metrics.json (docs/formats.md#events): checks, event_errors,
 // event_warnings and the "events" array (fields as the columns of events.csv).
 void put_events_json(const std::vector<verify::Event>& events, bool checks, nlohmann::json& j);
+// --design: the comparison's keys of metrics.json (design_*, max_gouge_*; docs/formats.md#metrics-design),
+// for batch, view and run alike.
+void put_design_json(const verify::DesignReport& d, const Profile& profile, nlohmann::json& j);
+// --design: the comparison in one line, "gouge V mm3, max D mm at X.. Y.. Z.. (FILE:LINE) |
+// excess V mm3, max D mm beyond T mm" (stdout of batch, view and run; the viewer's HUD).
+[[nodiscard]] std::string design_summary(const verify::DesignReport& d, double tolerance_mm);
 // Metrics of a batch run as a JSON document (keys in docs/formats.md#metrics).
 [[nodiscard]] std::string batch_metrics_json(const BatchResult& r, const Profile& profile, const std::string& program);
 

@@ -16,6 +16,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <thread>
@@ -74,9 +75,13 @@ struct LoadedSnapshot {
 // The writer thread and its one-slot hand-over from the geometry thread.
 class SnapshotWriter {
  public:
+  // Called on the writer thread after each periodic snapshot is written, with the state it
+  // holds (the solid at a batch boundary), before the slot is freed: work on a consistent
+  // copy of the stock off the real-time threads (run --design compares it, docs/verification.md#live-design).
+  using AfterWrite = std::function<void(const SnapshotState&)>;
   // `dir` is created; `first_generation`: generation of the first file written (the one
   // after the resumed snapshot's). Starts the thread.
-  SnapshotWriter(std::string dir, std::uint64_t first_generation);
+  SnapshotWriter(std::string dir, std::uint64_t first_generation, AfterWrite after_write = {});
   ~SnapshotWriter();  // finishes a pending write, joins
   SnapshotWriter(const SnapshotWriter&) = delete;
   SnapshotWriter& operator=(const SnapshotWriter&) = delete;
@@ -102,6 +107,7 @@ class SnapshotWriter {
   enum : int { kFree = 0, kFilled = 1 };
   std::string dir_;
   std::uint64_t generation_;
+  AfterWrite after_write_;
   SnapshotState slot_;
   std::atomic<int> state_{kFree};
   std::atomic<bool> quit_{false};

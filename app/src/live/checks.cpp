@@ -10,14 +10,9 @@ namespace lbr::app::live {
 
 namespace {
 
-// A step faster than the max cutting feed by more than this is fast: the emulator caps feeds
-// at the limit exactly, and sampled positions carry rounding (docs/verification.md#live).
-constexpr double kFastMargin = 1.05;
-
-// The profile's max cutting feed: [machine] max_feed_mm_per_min, or half the rapid rate
-// when the profile sets no feed cap [mm/min].
+// The profile's max cutting feed (verify::rapid_threshold_mm_per_min) [mm/min].
 double rapid_threshold(const Profile& p) {
-  return p.machine.max_feed_mm_per_min > 0.0 ? p.machine.max_feed_mm_per_min : 0.5 * p.machine.rapid_mm_per_min;
+  return verify::rapid_threshold_mm_per_min(p.machine.max_feed_mm_per_min, p.machine.rapid_mm_per_min);
 }
 
 gfx::AlarmSeverity alarm_severity(verify::Severity s) noexcept {
@@ -33,7 +28,7 @@ LiveChecks::LiveChecks(const Profile& profile, const motion::ToolTable& tools, s
       period_s_(profile.live.period_ms * 1e-3),
       checker_(profile.checks, tools, index_),
       lines_(std::move(lines)) {
-  fast_step_mm_ = kFastMargin * rapid_mm_per_min_ / 60.0 * period_s_;
+  fast_step_mm_ = verify::kFastMargin * rapid_mm_per_min_ / 60.0 * period_s_;
   moves_.reserve(batch_capacity);
   info_.reserve(batch_capacity);
   rapid_.reserve(batch_capacity);
@@ -63,13 +58,13 @@ void LiveChecks::begin(std::span<const geom::SweepRef> batch, std::span<const mo
 
 std::size_t LiveChecks::check(const geom::LbrSolid& solid, std::size_t from, std::size_t to, const TickSamples& tick) {
   if (!enabled_ || to > moves_.size()) return to;
-  // Up to three events a sweep; without room for them the findings are counted only.
-  const bool room = events_.size() + 3 <= kMaxEvents;
+  // Up to kKindsPerSweep events a sweep; without room for them the findings are counted only.
+  const bool room = events_.size() + kKindsPerSweep <= kMaxEvents;
   std::vector<verify::Event>& list = room ? events_ : overflow_;
   if (!room) overflow_.clear();
   const std::size_t before = list.size();
-  std::array<double, 3> volume{};  // of the last events: one that grows was extended
-  for (std::size_t b = 0; b < std::min<std::size_t>(3, before); ++b) volume[b] = list[before - 1 - b].volume_mm3;
+  std::array<double, kKindsPerSweep> volume{};  // of the last events: one that grows was extended
+  for (std::size_t b = 0; b < std::min(kKindsPerSweep, before); ++b) volume[b] = list[before - 1 - b].volume_mm3;
   const std::size_t end = checker_.check(solid, moves_, rapid_, from, to, list);
   record(from, before, volume, list, tick);  // only sweep `from` can have findings (CollisionChecker::check)
   if (!room) dropped_ += overflow_.size();
@@ -82,17 +77,17 @@ std::int64_t LiveChecks::rx_of(const motion::SweepInfo& info, const TickSamples&
   return tick.rx_ns.empty() ? 0 : tick.rx_ns.front();
 }
 
-void LiveChecks::record(std::size_t k, std::size_t events_before, const std::array<double, 3>& volume_before,
+void LiveChecks::record(std::size_t k, std::size_t events_before, const std::array<double, kKindsPerSweep>& volume_before,
                         std::vector<verify::Event>& list, const TickSamples& tick) {
   const motion::SweepInfo& info = info_[k];
   const geom::MoveId first = moves_[k].ref.id;
   bool found = false;
   // The events the sweep raised or extended: new ones, and older ones whose volume grew
   // (add_event() left the last_move of both at `first`).
-  for (std::size_t back = 0; back < std::min<std::size_t>(3, list.size()); ++back) {
+  for (std::size_t back = 0; back < std::min(kKindsPerSweep, list.size()); ++back) {
     const std::size_t i = list.size() - 1 - back;
     verify::Event& e = list[i];
-    const bool extended = i < events_before && events_before - 1 - i < 3 && e.volume_mm3 > volume_before[events_before - 1 - i];
+    const bool extended = i < events_before && events_before - 1 - i < kKindsPerSweep && e.volume_mm3 > volume_before[events_before - 1 - i];
     if (e.last_move != first || (i < events_before && !extended)) continue;
     found = true;
     e.last_move = static_cast<geom::MoveId>(info.last_seq & 0xFFFFFFFFU);

@@ -58,6 +58,8 @@ class LiveChecks {
  public:
   static constexpr std::size_t kMaxEvents = 4096;
   static constexpr int kShownAlarms = 3;  // newest events shown in the status bar
+  // Kinds one sweep can raise at once: rapid, plunge, shank, holder, spindle nose.
+  static constexpr std::size_t kKindsPerSweep = 5;
 
   // `batch_capacity`: the motion stream's batch size. `lines` (may be empty): program lines
   // of an emulated program's samples. Setup: allocates.
@@ -89,7 +91,7 @@ class LiveChecks {
 
  private:
   // After a check that found something in sweep k: sample numbers, lines, times, the note.
-  void record(std::size_t k, std::size_t events_before, const std::array<double, 3>& volume_before,
+  void record(std::size_t k, std::size_t events_before, const std::array<double, kKindsPerSweep>& volume_before,
               std::vector<verify::Event>& list, const TickSamples& tick);
   [[nodiscard]] std::int64_t rx_of(const motion::SweepInfo& info, const TickSamples& tick) const noexcept;
 

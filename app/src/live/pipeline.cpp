@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "app/batch.hpp"
 #include "app/live.hpp"
 #include "app/outputs.hpp"
 #include "geom/lbr_solid.hpp"
@@ -54,6 +55,7 @@ struct LivePipeline::Impl {
   std::unique_ptr<live::LiveChecks> checks;  // collision checks on the geometry thread (null: off)
   std::shared_ptr<const nc::Emulator> emulator;        // an emulator source's (its plan)
   std::unique_ptr<live::ProgramPosition> position;     // line, machining time for the status bar
+  std::vector<geom::Paths> design;                     // --design: the model's sections (load_design)
   // Power-loss snapshots (app/snapshot.hpp): the writer, its period, and the counters of
   // the resumed parts before this run.
   std::unique_ptr<SnapshotWriter> snap;
@@ -380,7 +382,12 @@ void start_snapshots(LivePipeline::Impl& p) {
     std::error_code ec;
     for (const char* f : {"snapshot-a.lbrsnap", "snapshot-b.lbrsnap"}) std::filesystem::remove(std::filesystem::path(dir) / f, ec);
   }
-  p.snap = std::make_unique<SnapshotWriter>(dir, generation);
+  SnapshotWriter::AfterWrite compare;  // --design: the snapshot's stock against the model
+  if (!p.design.empty() && p.opt.on_design_report)
+    compare = [&p](const SnapshotState& s) {
+      p.opt.on_design_report(verify::compare_design(p.design, s.solid, p.profile.design.tolerance_mm), false);
+    };
+  p.snap = std::make_unique<SnapshotWriter>(dir, generation, std::move(compare));
   p.snapshot_period_ns = static_cast<std::int64_t>(p.profile.live.snapshot_s * 1e9);
 }
 
@@ -401,6 +408,14 @@ void fill_check_results(const LivePipeline::Impl& p, LiveResult& r) {
   r.check_p50_ms = ms(ct.percentile_ns(0.5));
   r.check_p99_ms = ms(ct.percentile_ns(0.99));
   r.check_max_ms = ms(ct.max_ns());
+}
+
+// --design: the final stock against the model, by the batch runner's comparison (no move
+// list to attribute the gouge to); its design-gouge event joins the checks' events.
+void fill_design_result(const LivePipeline::Impl& p, LiveResult& r) {
+  if (p.profile.design.stl_path.empty()) return;
+  r.design = compare_with_design(p.profile, p.design, r.solid, {}, verify::MoveIndex{}, r.events);
+  if (p.opt.on_design_report) p.opt.on_design_report(*r.design, true);
 }
 
 // The status bar's program position: the emulator source's plan, or --program's moves.
@@ -487,6 +502,7 @@ void LivePipeline::configure() {
   p.r.emplace(LiveResult{geom::LbrSolid(live_solid_spec(profile, *p.tools)), p.opt.source, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
                          {}, 0, 0, 0, 0, 0, 0, ""});
   p.r->stock_volume_mm3 = p.r->solid.initial_volume_mm3();
+  p.design = load_design(profile, p.r->solid);  // before the source opens: its errors come first
   if (p.opt.progress != nullptr) p.progress = p.opt.progress;
   const SnapshotState* resume = p.opt.resume;
   if (resume != nullptr) resume_from(p, *resume);
@@ -533,6 +549,7 @@ void LivePipeline::configure() {
   }
   p.geo->set_exchange(p.opt.exchange);
   configure_program(p);
+  if (p.opt.on_design && !p.design.empty()) p.opt.on_design(p.design);
   if (p.opt.on_start) p.opt.on_start(p.r->solid);
   p.r->solid.clear_dirty();  // the render side starts from this state
 }
@@ -654,6 +671,7 @@ LiveResult LivePipeline::result() {
     r.snapshot_copy_max_ms = static_cast<double>(p.snapshot_copy_max_ns.load()) * 1e-6;
     r.snapshots_failed = p.snap->failed();
   }
+  fill_design_result(p, r);  // after the writer thread's last periodic comparison
   return std::move(r);
 }
 

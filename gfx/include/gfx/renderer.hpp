@@ -43,6 +43,7 @@ struct RenderOptions {
   double section_mm = 0;
   bool section_flip = false;
   std::string notice;  // a warning line on the HUD (e.g. input that does not match the profile)
+  std::string design;  // the design comparison's figures on the HUD (--design: gouge, excess); empty: none
   DeviationFn deviation;  // ColorMode::Deviation's per-vertex values; empty: that mode draws plain
   mesh::MeshOptions mesh;
   int max_regions_per_frame = 16;   // upper bound of the adaptive per-frame rebuild limit

@@ -84,6 +84,8 @@ class Emulator {
     int arc = -1;             // Arc: index into arcs()
     int tool = 0;             // tool during the piece
     int line = 0;             // source line (a blend arc: the line of the move it leaves)
+    Spindle spindle = Spindle::Unknown;  // the segment's spindle state and S word (sampled_toolpath
+    double spindle_s = 0.0;              // carries them, so batch --sampled judges spindle-off)
   };
   // Blend arc: position at path length s is centre + radius (cos(s/r) e1 + sin(s/r) e2).
   struct ArcGeom {
@@ -113,6 +115,8 @@ class Emulator {
 
 // The sampled stream as a tool path, as live mode sees it: one Feed segment from sample to
 // sample (has_tool_axis false; feed = distance / period), a ToolChange where the tool changes.
+// Each segment keeps the line and spindle state of the program move it samples (G0 becomes
+// Feed: a rapid is told by its speed, as in live mode; docs/verification.md).
 [[nodiscard]] Toolpath sampled_toolpath(const Toolpath& path, const EmulatorLimits& limits);
 
 }  // namespace lbr::nc

@@ -4,7 +4,8 @@
 // Checks: a rapid sweep that removes material (rapid-into-material); the non-cutting parts
 // of a milling tool, the shank (between the flutes' end and the gauge length, at the shank
 // diameter) and the holder (from the gauge length up, at the holder diameter), meeting
-// material (shank-in-material, holder-in-material); a cutting sweep that removes material
+// material (shank-in-material, holder-in-material), and the spindle nose above the holder
+// (spindle-nose-in-material, [checks] spindle_nose_*); a cutting sweep that removes material
 // while the segment's spindle is off (spindle-off) or faster than the feed limit
 // (feed-limit); the centre core of a non-centre-cutting tool meeting material on a descent
 // steeper than the ramp limit (plunge-non-centre-cutting). Turning inserts are not checked.
@@ -46,7 +47,22 @@ struct CheckConfig {
   // plunge-non-centre-cutting: a descent along the tool axis steeper than this (from the
   // plane normal to the axis) is a plunge [deg].
   double max_ramp_angle_deg = 3.0;
+  // spindle-nose-in-material: the spindle nose, a cylinder of this diameter and length from
+  // the holder's top face (tip + length_mm + holder_length_mm) up the tool axis; the same for
+  // every tool (a machine part, e.g. a mill5 head's nose) [mm]; diameter 0: not checked.
+  double spindle_nose_diameter_mm = 0.0;
+  double spindle_nose_length_mm = 0.0;
 };
+
+// A sampled stream has no G0 (live mode, batch --sampled): a step is a rapid when it moves the
+// tip faster than kFastMargin times rapid_threshold_mm_per_min() — the emulator caps feeds at
+// the limit exactly and sampled positions carry rounding (docs/verification.md#live).
+inline constexpr double kFastMargin = 1.05;
+// The profile's max cutting feed: `max_feed_mm_per_min` ([machine] max_feed_mm_per_min), or
+// half of `rapid_mm_per_min` when the profile sets no feed cap (0) [mm/min].
+[[nodiscard]] inline double rapid_threshold_mm_per_min(double max_feed_mm_per_min, double rapid_mm_per_min) noexcept {
+  return max_feed_mm_per_min > 0.0 ? max_feed_mm_per_min : 0.5 * rapid_mm_per_min;
+}
 
 // The centre core of a non-centre-cutting tool (the part of the end face that does not cut)
 // is taken as this fraction of its cutting diameter (docs/verification.md).
@@ -89,20 +105,23 @@ class CollisionChecker {
                     std::size_t to, std::vector<Event>& events);
   // The same for a live sample stream, which has no program to tell rapids by: moves[i] is
   // a rapid when rapid[i] is non-zero (the caller's speed test, docs/verification.md#live).
-  // Live sub-batches are short and their events are timed per sweep, so here every sweep
-  // after the first that meets material ends the call (no runs: only moves[from] can have
-  // findings).
+  // `runs` false (live: sub-batches are short and each event is timed against its sweep):
+  // every sweep after the first that meets material ends the call, so only moves[from] can
+  // have findings. `runs` true (the batch runner, also for --sampled): as the first check().
   std::size_t check(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
-                    std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to, std::vector<Event>& events);
+                    std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to, std::vector<Event>& events,
+                    bool runs = false);
 
   [[nodiscard]] const CheckConfig& config() const noexcept { return config_; }
 
  private:
   struct Parts {
-    geom::CutterShape shank, holder, core;
+    geom::CutterShape shank, holder, core, nose;
     double shank_from_mm = 0.0;   // shank bottom above the tip [mm]
     double holder_from_mm = 0.0;  // holder face above the tip [mm]
+    double nose_from_mm = 0.0;    // spindle nose face above the tip [mm]
     bool has_shank = false;
+    bool has_nose = false;        // [checks] spindle_nose_diameter_mm set
     bool centre_cutting = true;   // false: `core` is the end face's non-cutting centre
   };
   struct Finding {
@@ -114,7 +133,7 @@ class CollisionChecker {
   std::size_t check_moves(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                           std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to,
                           std::vector<Event>& events, bool runs);
-  static constexpr int kMaxFindings = 6;
+  static constexpr int kMaxFindings = 7;
   bool contact_only_ = false;  // check(): the move continues a run (IntrusionProbe::measure)
   using Findings = Finding[kMaxFindings];
   // The findings of one move against `solid`; returns how many were written. `rapid`: 1 / 0
@@ -125,8 +144,12 @@ class CollisionChecker {
   // new count.
   int segment_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const nc::Segment* seg, int rapid,
                        Findings& out, int n);
-  // Plunge (the non-cutting core), shank and holder, written from out[n]; returns the new count.
+  // Plunge (the non-cutting core), shank, holder and spindle nose, written from out[n];
+  // returns the new count.
   int part_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const Parts& p, Findings& out, int n);
+  // A part's cylinder swept with the move, raised `from_mm` along the tool axis: its finding.
+  bool raised_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, const geom::CutterShape& part,
+                      double from_mm, EventKind kind, Finding& out);
   [[nodiscard]] Event event_of(const motion::TimedSweep& m, const Finding& f) const;
 
   CheckConfig config_;

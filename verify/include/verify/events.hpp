@@ -26,6 +26,7 @@ enum class EventKind : unsigned char {
   FeedLimit,          // a feed move removes material faster than [checks] max_cutting_feed_mm_per_min
   OverTravel,         // a move ends outside the machine's axis travel ([machine] travel_*)
   DesignGouge,        // the final stock lacks design material deeper than the design tolerance
+  SpindleNoseInMaterial,  // the spindle nose above the holder ([checks] spindle_nose_*: mill5 heads) meets material
 };
 enum class Severity : unsigned char { Warning, Error };
 
