@@ -28,53 +28,58 @@ struct Walker {
   }
   // At the disk shared by moves p (ending there) and q (starting there), from vertex a to
   // vertex b: along the disk when a lies on the cap interval [lo, hi] of the other move (the
-  // outer side of the turn), else on the inner side through the centre, or by the chord a-b
-  // when chord_is_covered().
+  // outer side of the turn), else on the inner side by the chord a-b, or through the centre
+  // where the chord is not proven (chord_is_exact()).
   void join(const MoveCaps& p, const MoveCaps& q, bool right) {
     const P2 c = p.c1;
     const double rho = p.rho1;
     const int a = right ? p.front_r : q.back_l, b = right ? q.back_r : p.front_l;
-    const int lo = right ? q.back_l : p.front_r, hi = right ? q.back_r : p.front_l;
-    if (on_arc(a, lo, hi, n)) {
+    if (along_disk(p, q, right)) {
       arc(c, rho, a, b);
       return;
     }
     vertex(c, rho, a);
-    if (!chord_is_covered(p, q, right)) buf.push_back(c);
+    if (!chord_is_exact(p, q)) {
+      buf.push_back(c);
+    } else if (a != b) {
+      notch(c, rho, a, b);
+    }
     vertex(c, rho, b);
   }
-  // The inner side of a join: the path through the centre c and the chord a-b differ by the
-  // triangle T = (c, b, a) inside the shared disk, which both sections contain. The outline
-  // is the sum of the sections with their caps replaced by spokes (docs/lbr-conventions.md,
-  // "Joined sections"), so T is covered twice, and the chord leaves it covered once, when T
-  // meets none of the four caps: the two at this disk lie on other angles (checked on the
-  // grid), and a far cap (p's start, q's end) spans at most half a turn, so the line along
-  // its spoke nearest T separates it from T (checked on T's vertices, with a margin of two
-  // kernel units for the rounding). A spoke to c crosses every neighbouring side within ρ of
-  // it; the chord crosses none.
-  bool chord_is_covered(const MoveCaps& p, const MoveCaps& q, bool right) const {
-    const P2 c = p.c1;
-    const int a = right ? p.front_r : q.back_l, b = right ? q.back_r : p.front_l;
-    const int steps = (a - b + n) % n;  // T spans [b, a] counter-clockwise
-    if (steps == 0 || steps > n / 8) return false;
-    auto strictly_inside = [&](int j) { return j != a && j != b && on_arc(j, b, a, n); };
-    if (strictly_inside(right ? p.front_l : p.front_r) || strictly_inside(right ? q.back_l : q.back_r)) return false;
-    if ((p.back_r - p.back_l + n) % n > n / 2 || (q.front_l - q.front_r + n) % n > n / 2) return false;
-    const P2 tri[3] = {c, {c.x + p.rho1 * uc[static_cast<std::size_t>(a)].x, c.y + p.rho1 * uc[static_cast<std::size_t>(a)].y},
-                       {c.x + p.rho1 * uc[static_cast<std::size_t>(b)].x, c.y + p.rho1 * uc[static_cast<std::size_t>(b)].y}};
-    constexpr double kMargin = 2.0 * kMmPerUnit;
-    // Signed side of T's vertices against the line through o along grid direction j; the
-    // far cap lies where sign * cross <= 0.
-    auto clear_of = [&](P2 o, int j, double sign) {
-      const P2 d = uc[static_cast<std::size_t>(j)];
-      for (const P2& t : tri)
-        if (sign * (d.x * (t.y - o.y) - d.y * (t.x - o.x)) <= kMargin) return false;
-      return true;
-    };
-    // Right side: p's back cap ends at spoke back_r (cap on the clockwise side of it), q's
-    // front cap starts at spoke front_r (cap on the counter-clockwise side). Left: mirrored.
-    return right ? clear_of(p.c0, p.back_r, 1.0) && clear_of(q.c1, q.front_r, -1.0)
-                 : clear_of(p.c0, p.back_l, -1.0) && clear_of(q.c1, q.front_l, 1.0);
+  // The notch point of the inner join a-b: from the chord's midpoint towards the centre c by
+  // half the chord's length (its edges at 45 degrees to the chord).
+  void notch(P2 c, double rho, int a, int b) {
+    const P2 ua = uc[static_cast<std::size_t>(a)], ub = uc[static_cast<std::size_t>(b)];
+    const P2 m{0.5 * (ua.x + ub.x), 0.5 * (ua.y + ub.y)};  // midpoint on the unit disk
+    const double half = 0.5 * std::hypot(ua.x - ub.x, ua.y - ub.y), mid = std::hypot(m.x, m.y);
+    const double f = (mid - half) / mid;  // scale of m: depth `half` towards the centre
+    buf.push_back({c.x + rho * f * m.x, c.y + rho * f * m.y});
+  }
+  // The join on this side goes along the disk (see join()).
+  bool along_disk(const MoveCaps& p, const MoveCaps& q, bool right) const {
+    return right ? on_arc(p.front_r, q.back_l, q.back_r, n) : on_arc(q.back_l, p.front_r, p.front_l, n);
+  }
+  // Counter-clockwise grid steps from i to j.
+  int steps(int i, int j) const { return (j - i + n) % n; }
+  // The inner joins at this disk may be chords (docs/lbr-conventions.md, "Joined sections"):
+  // the outline is the sum of the sections' boundaries minus, at each shared disk D, the
+  // closed path G = p's front cap, the left join backwards, q's back cap, the right join
+  // backwards. Every vertex of G lies on D, so G is nonzero only inside D, which lies in
+  // both sections; where G's vertices run once around D counter-clockwise (the grid steps
+  // between them sum to n), G is a convex polygon inscribed in D and winds at most once,
+  // and the sum keeps winding >= 1 exactly on the union of the sections. A join along the
+  // disk retraces part of a cap backwards, so only the rest of that cap counts.
+  bool chord_is_exact(const MoveCaps& p, const MoveCaps& q) const {
+    const bool right_arc = along_disk(p, q, true), left_arc = along_disk(p, q, false);
+    if (right_arc && left_arc) return false;  // no chord here
+    if (right_arc)  // G: p.front_r -> p.front_l (cap), chord to q.back_l, q.back_l -> p.front_r (rest of q's cap)
+      return steps(p.front_r, p.front_l) + steps(p.front_l, q.back_l) + steps(q.back_l, p.front_r) == n;
+    if (left_arc)  // G: p.front_r -> q.back_l (rest of p's cap), q.back_l -> q.back_r (cap), chord to p.front_r
+      return steps(p.front_r, q.back_l) + steps(q.back_l, q.back_r) + steps(q.back_r, p.front_r) == n;
+    // Both inner: both caps and both chords.
+    return steps(p.front_r, p.front_l) + steps(p.front_l, q.back_l) + steps(q.back_l, q.back_r) +
+               steps(q.back_r, p.front_r) ==
+           n;
   }
   void side(const std::vector<P2>& pts) { buf.insert(buf.end(), pts.begin(), pts.end()); }
 };
