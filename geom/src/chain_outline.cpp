@@ -28,8 +28,8 @@ struct Walker {
   }
   // At the disk shared by moves p (ending there) and q (starting there), from vertex a to
   // vertex b: along the disk when a lies on the cap interval [lo, hi] of the other move (the
-  // outer side of the turn), else on the inner side by the chord a-b, or through the centre
-  // where the chord is not proven (chord_is_exact()).
+  // outer side of the turn), else on the inner side by a shallow notch a-m-b
+  // (notch_is_exact()), or through the centre c where the notch is not proven.
   void join(const MoveCaps& p, const MoveCaps& q, bool right) {
     const P2 c = p.c1;
     const double rho = p.rho1;
@@ -39,21 +39,24 @@ struct Walker {
       return;
     }
     vertex(c, rho, a);
-    if (!chord_is_exact(p, q)) {
+    if (!notch_is_exact(p, q)) {
       buf.push_back(c);
     } else if (a != b) {
       notch(c, rho, a, b);
     }
     vertex(c, rho, b);
   }
-  // The notch point of the inner join a-b: from the chord's midpoint towards the centre c by
-  // half the chord's length (its edges at 45 degrees to the chord).
+  // The notch point m of the inner join a-b: from the chord's midpoint towards the centre c
+  // by half the chord's length, so that a-m and m-b meet the chord at 45 degrees. (The chord
+  // itself is exact too, but it runs almost along both sides it joins, backwards, and
+  // Clipper's rounded crossings of such near-collinear edges leave zero-area spikes in the
+  // result.) The chord spans at most a quarter turn, so m lies between it and c.
   void notch(P2 c, double rho, int a, int b) {
     const P2 ua = uc[static_cast<std::size_t>(a)], ub = uc[static_cast<std::size_t>(b)];
-    const P2 m{0.5 * (ua.x + ub.x), 0.5 * (ua.y + ub.y)};  // midpoint on the unit disk
-    const double half = 0.5 * std::hypot(ua.x - ub.x, ua.y - ub.y), mid = std::hypot(m.x, m.y);
-    const double f = (mid - half) / mid;  // scale of m: depth `half` towards the centre
-    buf.push_back({c.x + rho * f * m.x, c.y + rho * f * m.y});
+    const P2 mid{0.5 * (ua.x + ub.x), 0.5 * (ua.y + ub.y)};  // on the unit disk
+    const double half = 0.5 * std::hypot(ua.x - ub.x, ua.y - ub.y), dist = std::hypot(mid.x, mid.y);
+    const double f = (dist - half) / dist;  // in [0, 1) for a chord of at most a quarter turn
+    buf.push_back({c.x + rho * f * mid.x, c.y + rho * f * mid.y});
   }
   // The join on this side goes along the disk (see join()).
   bool along_disk(const MoveCaps& p, const MoveCaps& q, bool right) const {
@@ -61,25 +64,32 @@ struct Walker {
   }
   // Counter-clockwise grid steps from i to j.
   int steps(int i, int j) const { return (j - i + n) % n; }
-  // The inner joins at this disk may be chords (docs/lbr-conventions.md, "Joined sections"):
-  // the outline is the sum of the sections' boundaries minus, at each shared disk D, the
+  // The inner joins at this disk may be notches (docs/lbr-conventions.md, "Joined sections").
+  // The outline is the sum of the sections' boundaries minus, at each shared disk D, the
   // closed path G = p's front cap, the left join backwards, q's back cap, the right join
-  // backwards. Every vertex of G lies on D, so G is nonzero only inside D, which lies in
-  // both sections; where G's vertices run once around D counter-clockwise (the grid steps
-  // between them sum to n), G is a convex polygon inscribed in D and winds at most once,
-  // and the sum keeps winding >= 1 exactly on the union of the sections. A join along the
-  // disk retraces part of a cap backwards, so only the rest of that cap counts.
-  bool chord_is_exact(const MoveCaps& p, const MoveCaps& q) const {
+  // backwards (a join along the disk retraces part of a cap, so only the rest of that cap
+  // counts). With chords for the inner joins, G's vertices lie on D; where they run once
+  // around D counter-clockwise (the grid steps between them sum to n) and no chord spans
+  // more than a quarter turn, G is a convex polygon inscribed in D around its centre, and
+  // with each chord replaced by its notch (inside the chord's sector) a simple polygon in D:
+  // it winds at most once, only inside D, which both sections contain. The sum then winds
+  // >= 1 exactly on the union of the sections and 0 elsewhere.
+  bool notch_is_exact(const MoveCaps& p, const MoveCaps& q) const {
     const bool right_arc = along_disk(p, q, true), left_arc = along_disk(p, q, false);
-    if (right_arc && left_arc) return false;  // no chord here
-    if (right_arc)  // G: p.front_r -> p.front_l (cap), chord to q.back_l, q.back_l -> p.front_r (rest of q's cap)
-      return steps(p.front_r, p.front_l) + steps(p.front_l, q.back_l) + steps(q.back_l, p.front_r) == n;
-    if (left_arc)  // G: p.front_r -> q.back_l (rest of p's cap), q.back_l -> q.back_r (cap), chord to p.front_r
-      return steps(p.front_r, q.back_l) + steps(q.back_l, q.back_r) + steps(q.back_r, p.front_r) == n;
+    const int q4 = n / 4;
+    if (right_arc && left_arc) return false;  // no inner join here
+    if (right_arc) {  // G: p's cap fr -> fl, chord to q.back_l, rest of q's cap to p.front_r
+      const int chord = steps(p.front_l, q.back_l);
+      return chord <= q4 && steps(p.front_r, p.front_l) + chord + steps(q.back_l, p.front_r) == n;
+    }
+    if (left_arc) {  // G: rest of p's cap fr -> q.back_l, q's cap bl -> br, chord to p.front_r
+      const int chord = steps(q.back_r, p.front_r);
+      return chord <= q4 && steps(p.front_r, q.back_l) + steps(q.back_l, q.back_r) + chord == n;
+    }
     // Both inner: both caps and both chords.
-    return steps(p.front_r, p.front_l) + steps(p.front_l, q.back_l) + steps(q.back_l, q.back_r) +
-               steps(q.back_r, p.front_r) ==
-           n;
+    const int left = steps(p.front_l, q.back_l), right = steps(q.back_r, p.front_r);
+    return left <= q4 && right <= q4 &&
+           steps(p.front_r, p.front_l) + left + steps(q.back_l, q.back_r) + right == n;
   }
   void side(const std::vector<P2>& pts) { buf.insert(buf.end(), pts.begin(), pts.end()); }
 };
