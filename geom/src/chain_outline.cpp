@@ -2,7 +2,9 @@
 #include "chain_outline.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
 #include <numbers>
 
 namespace lbr::geom::detail {
@@ -134,15 +136,103 @@ bool emit_path(const std::vector<P2>& pts, Paths& out, std::vector<Path>& spare)
   return true;
 }
 
+// ---- Tight loops: the outline without its inner chain (docs/lbr-conventions.md, "Joined
+// sections", star outline) ----
+
+constexpr double kStarMarginMm = 4.0 * kMmPerUnit;  // beyond the rounding of vertices to units
+constexpr std::size_t kStarIntervals = 32;
+
+// The mean of the run's disk centres, when every disk polygon (inscribed radius
+// rho·cos(pi/n)) holds it with a margin: then every section contains it.
+bool loop_centre(std::span<const MoveCaps> moves, int n, P2& o) {
+  double sx = 0.0, sy = 0.0;
+  for (const MoveCaps& mc : moves) {
+    sx += mc.c0.x;
+    sy += mc.c0.y;
+  }
+  sx += moves.back().c1.x;
+  sy += moves.back().c1.y;
+  const double count = static_cast<double>(moves.size() + 1);
+  o = {sx / count, sy / count};
+  const double inscribed = std::cos(std::numbers::pi / n);
+  auto holds = [&](P2 c, double rho) { return std::hypot(c.x - o.x, c.y - o.y) < rho * inscribed - kStarMarginMm; };
+  for (const MoveCaps& mc : moves)
+    if (!holds(mc.c0, mc.rho0) || !holds(mc.c1, mc.rho1)) return false;
+  return true;
+}
+
+double dist_to_segment(P2 o, P2 a, P2 b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, l2 = dx * dx + dy * dy;
+  const double t = l2 > 0.0 ? std::clamp(((o.x - a.x) * dx + (o.y - a.y) * dy) / l2, 0.0, 1.0) : 0.0;
+  return std::hypot(a.x + t * dx - o.x, a.y + t * dy - o.y);
+}
+
+// The chain C = buf[first], buf[first + 1], ... (count vertices, cyclic indices) winds
+// counter-clockwise about o edge by edge, and its edges farther than r from o cover every
+// direction from o.
+bool chain_covers_turn(const std::vector<P2>& buf, std::size_t first, std::size_t count, P2 o, double r) {
+  const std::size_t nb = buf.size();
+  std::array<std::pair<double, double>, kStarIntervals> iv;
+  std::size_t ni = 0;
+  double theta = 0.0, run_from = -1.0;
+  constexpr double kTurn = 2.0 * std::numbers::pi;
+  auto close_run = [&](double to) {  // [run_from, to] split at whole turns
+    for (double a = run_from; a < to;) {
+      const double base = std::floor(a / kTurn) * kTurn, b = std::min(to, base + kTurn);
+      if (ni == kStarIntervals) return false;
+      iv[ni++] = {a - base, b - base};
+      a = b;
+    }
+    run_from = -1.0;
+    return true;
+  };
+  for (std::size_t t = 0; t + 1 < count; ++t) {
+    const P2 a = buf[(first + t) % nb], b = buf[(first + t + 1) % nb];
+    const double ax = a.x - o.x, ay = a.y - o.y, bx = b.x - o.x, by = b.y - o.y;
+    const double cross = ax * by - ay * bx, dot = ax * bx + ay * by;
+    if (cross < 0.0 || (cross == 0.0 && dot <= 0.0)) return false;  // not counter-clockwise about o
+    const bool good = dist_to_segment(o, a, b) > r;
+    if (good && run_from < 0.0) run_from = theta;
+    if (!good && run_from >= 0.0 && !close_run(theta)) return false;
+    theta += std::atan2(cross, dot);
+  }
+  if (run_from >= 0.0 && !close_run(theta)) return false;
+  std::sort(iv.begin(), iv.begin() + static_cast<std::ptrdiff_t>(ni));
+  double reach = 0.0;
+  for (std::size_t i = 0; i < ni; ++i) {
+    if (iv[i].first > reach) return false;
+    reach = std::max(reach, iv[i].second);
+  }
+  return reach >= kTurn;
+}
+
+// When the chain of `count` vertices from buf[first] (cyclic) qualifies, the outline may be
+// that chain closed through the loop centre o: the rest of the outline lies within r_in of
+// o, and the chain covers every direction beyond r_in. Replaces buf by that outline.
+bool keep_star_chain(std::vector<P2>& buf, std::size_t first, std::size_t count, P2 o) {
+  const std::size_t nb = buf.size();
+  double r_in = 0.0;  // the rest, from the chain's last vertex round to its first
+  for (std::size_t t = count - 1; t <= nb; ++t) {
+    const P2 v = buf[(first + t) % nb];
+    r_in = std::max(r_in, std::hypot(v.x - o.x, v.y - o.y));
+  }
+  if (!chain_covers_turn(buf, first, count, o, r_in + kStarMarginMm)) return false;
+  std::rotate(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(first), buf.end());
+  buf.resize(count);
+  buf.push_back(o);
+  return true;
+}
+
 }  // namespace
 
 bool append_outline(std::span<const MoveCaps> moves, int n, const std::vector<P2>& uc, std::vector<P2>& buf,
-                    Paths& out, std::vector<Path>& spare) {
+                    Paths& out, std::vector<Path>& spare, bool& star) {
   buf.clear();
   Walker w{uc, n, buf};
   const std::size_t m = moves.size();
   // Back cap of the first move, then the right sides forward.
   w.arc(moves[0].c0, moves[0].rho0, moves[0].back_l, moves[0].back_r);
+  const std::size_t back_cap_end = buf.size();
   for (std::size_t k = 0; k < m; ++k) {
     const MoveCaps& a = moves[k];
     w.side(a.right);
@@ -151,7 +241,9 @@ bool append_outline(std::span<const MoveCaps> moves, int n, const std::vector<P2
     }
   }
   // Front cap of the last move, then the left sides back.
+  const std::size_t front_cap_begin = buf.size();
   w.arc(moves[m - 1].c1, moves[m - 1].rho1, moves[m - 1].front_r, moves[m - 1].front_l);
+  const std::size_t front_cap_end = buf.size();
   for (std::size_t k = m; k-- > 0;) {
     const MoveCaps& b = moves[k];
     w.side(b.left);
@@ -159,6 +251,13 @@ bool append_outline(std::span<const MoveCaps> moves, int n, const std::vector<P2
       w.join(moves[k - 1], b, false);
     }
   }
+  // A tight loop: its outer chain alone, closed through the loop's centre. Counter-clockwise
+  // loops keep the back cap, the right sides and the front cap; clockwise ones the front
+  // cap, the left sides and the back cap.
+  P2 o{};
+  star = m >= 2 && loop_centre(moves, n, o) &&
+         (keep_star_chain(buf, 0, front_cap_end, o) ||
+          keep_star_chain(buf, front_cap_begin, buf.size() - front_cap_begin + back_cap_end, o));
   return emit_path(buf, out, spare);
 }
 

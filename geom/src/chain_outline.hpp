@@ -21,9 +21,11 @@ namespace lbr::geom::detail {
 
 // Appends the outline of `moves` (at least two, consecutive: moves[k].c1 == moves[k+1].c0,
 // all on the grid of n directions, unit circle `uc`) to `out` as one closed path in kernel
-// units, collinear and repeated vertices dropped. `buf` is a reusable buffer. Returns false
-// (and appends nothing) when fewer than three vertices remain.
+// units, collinear and repeated vertices dropped. `buf` is a reusable buffer. A tight loop
+// (a centre inside every disk of the run, docs/lbr-conventions.md) may be written as its
+// outer chain only, closed through that centre; `star` is then set. Returns false (and
+// appends nothing) when fewer than three vertices remain.
 bool append_outline(std::span<const MoveCaps> moves, int n, const std::vector<SectionScratch::P2>& uc,
-                    std::vector<SectionScratch::P2>& buf, Paths& out, std::vector<Path>& spare);
+                    std::vector<SectionScratch::P2>& buf, Paths& out, std::vector<Path>& spare, bool& star);
 
 }  // namespace lbr::geom::detail

@@ -159,8 +159,10 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
         ++count;
       if (count >= 2) {
         const std::size_t before = ls.paths.size();
+        bool star = false;
         detail::append_outline(std::span<const MoveCaps>(ws.caps.data(), count), grid, ws.scratch.unit_circle(grid),
-                               ws.outline, ls.paths, ws.scratch.spare);
+                               ws.outline, ls.paths, ws.scratch.spare, star);
+        if (star) ++stats.outlines_star;
         MoveId id = 0;
         for (std::size_t k = 0; k < count; ++k) id = std::max(id, sh.sweep_id[si + k]);
         push_boxes(before, id);
