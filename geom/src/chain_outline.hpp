@@ -5,10 +5,12 @@
 // finishing path puts 20-50 sections over every point of a level. Fed to the clip as
 // separate polygons, those overlaps cost the Vatti sweep quadratically. Instead the run is
 // written as one closed path that walks the right sides forward and the left sides back,
-// joined at each shared disk either along the disk (on the outer side of a turn) or through
-// its centre (on the inner side), as a polygon offset is built. docs/lbr-conventions.md
-// ("Joined sections") shows that its winding number is positive exactly on the union of the
-// sections and zero elsewhere, so the clip's non-zero fill removes the same region.
+// joined at each shared disk either along the disk (on the outer side of a turn) or by a
+// shallow notch into it (on the inner side; through its centre where the notch is not
+// proven). A tight loop may keep only its outer chain, closed through the loop's centre.
+// docs/lbr-conventions.md ("Joined sections") shows that its winding number is positive
+// exactly on the union of the sections and zero elsewhere, so the clip's non-zero fill
+// removes the same region.
 #pragma once
 
 #include <span>
