@@ -103,6 +103,88 @@ TEST(Joined, HelicalEntryIntoAPocketLeavesThePocket) {
 
 namespace {
 
+// A helix as the kinematics splits it: `per_turn` chords a turn, turning counter-clockwise
+// (ccw) or clockwise, from z0 down by `pitch` a turn for `turns` turns, then a flat turn.
+std::vector<geom::Vec3> helix_dir(double cx, double cy, double rho, double z0, double pitch, int turns, int per_turn,
+                                  bool ccw) {
+  auto p = helix(cx, cy, rho, z0, pitch, turns, per_turn);
+  if (!ccw)
+    for (geom::Vec3& v : p) v.y = 2.0 * cy - v.y;
+  return p;
+}
+
+}  // namespace
+
+TEST(Joined, TightHelicalBoreIsTheDiskTimesTheDepth) {
+  // Flat Ø10 on a helix of radius 3 (below the tool radius: a tight loop), 4 turns of
+  // 1.25 mm, then a flat turn at -5: every level above -5 loses the disk r <= 8. Whole
+  // turns in one batch (as tight_loop_end() cuts them) and parts of turns (37 moves).
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
+  const double exact = test::kPi * 64.0 * 5.0;
+  const double perimeter = 2.0 * test::kPi * 8.0;
+  for (const bool ccw : {true, false}) {
+    for (const int batch : {180, 37}) {
+      geom::LbrSolid s(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+      std::vector<geom::SweepRef> moves;
+      const auto path = helix_dir(30, 20, 3, 0, 1.25, 4, 180, ccw);  // chord sag 3·(1 - cos 1°) = 0.46 µm
+      geom::SubtractStats st;
+      for (std::size_t i = 1; i < path.size(); ++i) {
+        moves.push_back({&c, {path[i - 1], {0, 0, 1}}, {path[i], {0, 0, 1}}, static_cast<geom::MoveId>(i)});
+        if (static_cast<int>(moves.size()) == batch || i + 1 == path.size()) {
+          st += s.subtract(moves);
+          moves.clear();
+        }
+      }
+      EXPECT_GT(st.outlines_star, 0u) << "ccw " << ccw << " batch " << batch;
+      EXPECT_NEAR(test::removed(s), exact, 2.0 * perimeter * kTol * 5.0) << "ccw " << ccw << " batch " << batch;
+      EXPECT_EQ(s.check_invariants(), "");
+    }
+  }
+}
+
+TEST(Joined, TightBallRampEqualsTheMovesCutOneByOne) {
+  // Ball Ø8 ramping on a radius of 1.5 (sections of every radius from 0 to 4 on the levels
+  // it crosses, tight on most of them), both directions, in batches of whole and part turns,
+  // against the same moves one by one (no outline at all).
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Ball, 8), kTol);
+  for (const bool ccw : {true, false}) {
+    const auto path = helix_dir(30, 20, 1.5, 0.5, 0.8, 4, 120, ccw);
+    geom::LbrSolid single(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+    test::cut_path(single, c, path, 1);
+    for (const int batch : {121, 50}) {
+      geom::LbrSolid joined(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+      test::cut_path(joined, c, path, batch);
+      const double perimeter = 2.0 * test::kPi * 5.5;
+      EXPECT_LT(max_level_area_gap(joined, single), 2.0 * perimeter * kTol) << "ccw " << ccw << " batch " << batch;
+      EXPECT_NEAR(test::removed(joined), test::removed(single), 2.0 * perimeter * kTol * 4.0);
+      EXPECT_GT(test::removed(joined), 150.0);
+      EXPECT_EQ(joined.check_invariants(), "");
+    }
+  }
+}
+
+TEST(Joined, CoarseTightLoopInShortBatchesEqualsTheMovesCutOneByOne) {
+  // 8 chords a turn of radius 3 under a flat Ø10 (45° turns, 2.3 mm chords), both
+  // directions, in batches of 2 to 9 moves: a run that turns less than a full circle about
+  // its centre keeps its inner chain where that chain bounds the union; each batch against
+  // the same moves one by one.
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
+  for (const bool ccw : {true, false}) {
+    const auto path = helix_dir(30, 20, 3, 0, 0.35, 2, 8, ccw);
+    geom::LbrSolid single(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+    test::cut_path(single, c, path, 1);
+    for (const int batch : {2, 3, 5, 9}) {
+      geom::LbrSolid joined(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+      test::cut_path(joined, c, path, batch);
+      const double perimeter = 2.0 * test::kPi * 8.0;
+      EXPECT_LT(max_level_area_gap(joined, single), 2.0 * perimeter * kTol) << "ccw " << ccw << " batch " << batch;
+      EXPECT_EQ(joined.check_invariants(), "");
+    }
+  }
+}
+
+namespace {
+
 // Lowest point of a ball (radius r) whose centre runs from a to b, above (x, y); +inf where
 // the ball does not pass over it. z(t) - sqrt(r² - d(t)²) is convex in t: ternary search.
 double ball_floor(double x, double y, const geom::Vec3& a, const geom::Vec3& b, double r) {

@@ -149,7 +149,7 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
     // Joined outline from si, when si and at least the next move share their joint disk.
     if (run.second - si >= 2) {
       // One angle grid along the run: the tool's full radius sets it. Even, so that a
-      // stadium's caps are exact half turns (chain_outline.cpp, chord_is_covered()).
+      // stadium's caps are exact half turns (chain_outline.cpp, notch_is_exact()).
       const int grid = (Sweep::circle_segments(sw.shape().radius(), sw.shape().chord_tol_mm) + 1) / 2 * 2;
       if (ws.caps.size() < run.second - si) ws.caps.resize(run.second - si);
       std::size_t count = 0;
@@ -159,8 +159,10 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
         ++count;
       if (count >= 2) {
         const std::size_t before = ls.paths.size();
+        bool star = false;
         detail::append_outline(std::span<const MoveCaps>(ws.caps.data(), count), grid, ws.scratch.unit_circle(grid),
-                               ws.outline, ls.paths, ws.scratch.spare);
+                               ws.outline, ls.paths, ws.scratch.spare, star);
+        if (star) ++stats.outlines_star;
         MoveId id = 0;
         for (std::size_t k = 0; k < count; ++k) id = std::max(id, sh.sweep_id[si + k]);
         push_boxes(before, id);
