@@ -103,9 +103,10 @@ void LbrSolid::init_cells(bool fill) {
   dirty_flag_.assign(cells_.size(), 0);
   std::vector<double> region_area(static_cast<std::size_t>(regions()));
   const Path circle = stock_circle();
+  Path cut, tmp;  // stock_polygons' scratch, reused over the regions
   for (int reg = 0; reg < regions(); ++reg) {
     Cell stock;
-    stock.polys = stock_polygons(reg, circle);
+    stock.polys = stock_polygons(reg, circle, cut, tmp);
     detail::refresh_cell(stock);
     region_area[static_cast<std::size_t>(reg)] = stock.area_units2;
     for (int l = 0; fill && l < levels_; ++l) cells_[static_cast<std::size_t>(reg) * levels_ + l] = stock;
@@ -134,7 +135,7 @@ Path LbrSolid::stock_circle() const {
   return circle;
 }
 
-std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle) const {
+std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle, Path& cut, Path& tmp) const {
   const Rect rr = region_rect(reg);
   std::vector<Polygon> polys;
   if (spec_.shape == SolidSpec::Shape::Box) {
@@ -157,7 +158,6 @@ std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle) const
         // Only the part of the outline near the region enters Clipper (cut_to_rect keeps it
         // vertex for vertex inside the region): a 4096-gon per region made a many-region
         // cylinder take seconds to build, and the levels file reader with it (fuzz_lbrs).
-        Path cut, tmp;
         detail::cut_to_rect(circle, rr, cut, tmp);
         ClipperLib::Clipper c;
         c.AddPath(cut, ClipperLib::ptSubject, true);
