@@ -24,7 +24,10 @@ for t in "${TARGETS[@]}"; do
   mkdir -p "$d/corpus" "$d/artifacts"
   t0=$(date +%s)
   rc=0
-  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 nice -n 19 "$BUILD/fuzz/fuzz_$t" -runs="$RUNS" \
+  # malloc_context_size=0: ASan records no stack per allocation (StackDepot::Put was 10-18 % of
+  # fuzz_lbrs' time); reports still show where the bad access is, and a crash input rerun
+  # without it shows the allocation's stack too.
+  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS="${ASAN_OPTIONS:-malloc_context_size=0}" nice -n 19 "$BUILD/fuzz/fuzz_$t" -runs="$RUNS" \
     -max_total_time="$SECONDS_MAX" -max_len="${MAXLEN[$t]}" -rss_limit_mb=2048 -print_final_stats=1 \
     -artifact_prefix="$d/artifacts/" "$d/corpus" "$SRC/corpus/$t" > "$d/log.txt" 2>&1 || rc=$?
   secs=$(( $(date +%s) - t0 ))

@@ -2,6 +2,7 @@
 // monotonicity and the representation invariants, on fixed and seeded random programs.
 #include <cstdlib>
 #include <cstring>
+#include <numbers>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -328,5 +329,64 @@ TEST(Invariants, ReaderBuildsNoStockCellsAndChecksTheLevelCountFirst) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("level count 4 does not match stock and spacing (10000000)"), std::string::npos)
         << e.what();
+  }
+}
+
+// Regression (fuzz_lbrs ran at a fraction of its speed on such inputs): a cylinder stock
+// over many regions intersected its whole polygonised circle (up to 4096 vertices) with
+// every region in Clipper, for LbrSolid and for the levels file reader, which builds the
+// stock's areas for the initial volume. Regions wholly inside or outside the circle skip
+// Clipper, crossed ones clip only the outline cut down to the region; every region's stock
+// must be the circle cut by the region exactly as before: the one-region solid's outline
+// (the circle in its bounding box) intersected with the region rectangle in Clipper.
+TEST(Invariants, RegressionManyRegionCylinderStockIsTheCircleCutByEachRegion) {
+  for (const int n : {1, 7, 48}) {
+    geom::SolidSpec sp = test::box_spec({0, 0, 0}, {1, 1, 2}, 1.0, n, n);
+    sp.shape = geom::SolidSpec::Shape::Cylinder;
+    sp.cylinder = {3.25, -1.5, 60.0, 0.0, 2.0};
+    sp.chord_tol_mm = 1e-4;  // the finest circle
+    geom::SolidSpec one = sp;
+    one.regions_x = one.regions_y = 1;
+    const geom::LbrSolid whole(one);
+    ASSERT_EQ(whole.cell(0, 0).polys.size(), 1u);
+    const geom::Path& outline = whole.cell(0, 0).polys[0].outer.pts;
+    ASSERT_GT(outline.size(), 1000u);
+    const geom::LbrSolid s(sp);
+    EXPECT_EQ(s.check_invariants(), "");
+    int inside = 0, outside = 0;
+    double sum_units2 = 0.0;
+    for (int r = 0; r < s.regions(); ++r) {
+      const geom::Rect rr = s.region_rect(r);
+      ClipperLib::Clipper c;
+      c.AddPath(outline, ClipperLib::ptSubject, true);
+      c.AddPath({{rr.x0, rr.y0}, {rr.x1, rr.y0}, {rr.x1, rr.y1}, {rr.x0, rr.y1}}, ClipperLib::ptClip, true);
+      ClipperLib::Paths ref;
+      c.Execute(ClipperLib::ctIntersection, ref, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+      double ref_units2 = 0.0;
+      std::size_t ref_vertices = 0;
+      for (const ClipperLib::Path& p : ref) {
+        ref_units2 += ClipperLib::Area(p);
+        ref_vertices += p.size();
+      }
+      const geom::Cell& cell = s.cell(r, 1);
+      std::size_t vertices = 0;
+      for (const geom::Polygon& p : cell.polys) vertices += p.outer.pts.size();
+      ASSERT_EQ(cell.polys.size(), ref.size()) << "n " << n << " region " << r;
+      EXPECT_EQ(vertices, ref_vertices) << "n " << n << " region " << r;
+      EXPECT_NEAR(cell.area_units2, ref_units2, 1e-9 * ref_units2) << "n " << n << " region " << r;
+      inside += ref_units2 == static_cast<double>(rr.x1 - rr.x0) * static_cast<double>(rr.y1 - rr.y0);
+      outside += ref.empty();
+      sum_units2 += cell.area_units2;
+    }
+    // The regions' cuts through the circle's edges round to whole units (4e-9 of the area here).
+    EXPECT_NEAR(sum_units2, whole.cell(0, 0).area_units2, 1e-7 * sum_units2) << "n " << n;
+    EXPECT_NEAR(s.initial_volume_mm3(), whole.initial_volume_mm3(), 1e-7 * whole.initial_volume_mm3());
+    EXPECT_NEAR(whole.initial_volume_mm3(), std::numbers::pi * 30.0 * 30.0 * 2.0, 0.01) << "n " << n;
+    if (n == 48) {
+      EXPECT_GT(inside, 1000) << "most regions lie wholly in the circle";
+      EXPECT_GT(outside, 100) << "the corners lie wholly outside it";
+    }
+    // The reader builds the same initial volume, to the bit.
+    EXPECT_EQ(geom::from_bytes(geom::to_bytes(s)).initial_volume_mm3(), s.initial_volume_mm3());
   }
 }

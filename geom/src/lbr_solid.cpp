@@ -103,9 +103,10 @@ void LbrSolid::init_cells(bool fill) {
   dirty_flag_.assign(cells_.size(), 0);
   std::vector<double> region_area(static_cast<std::size_t>(regions()));
   const Path circle = stock_circle();
+  Path cut, tmp;  // stock_polygons' scratch, reused over the regions
   for (int reg = 0; reg < regions(); ++reg) {
     Cell stock;
-    stock.polys = stock_polygons(reg, circle);
+    stock.polys = stock_polygons(reg, circle, cut, tmp);
     detail::refresh_cell(stock);
     region_area[static_cast<std::size_t>(reg)] = stock.area_units2;
     for (int l = 0; fill && l < levels_; ++l) cells_[static_cast<std::size_t>(reg) * levels_ + l] = stock;
@@ -134,7 +135,7 @@ Path LbrSolid::stock_circle() const {
   return circle;
 }
 
-std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle) const {
+std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle, Path& cut, Path& tmp) const {
   const Rect rr = region_rect(reg);
   std::vector<Polygon> polys;
   if (spec_.shape == SolidSpec::Shape::Box) {
@@ -143,14 +144,51 @@ std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle) const
     p.bbox = rr;
     polys.push_back(std::move(p));
   } else {
-    ClipperLib::Clipper c;
-    c.AddPath(circle, ClipperLib::ptSubject, true);
-    c.AddPath(detail::rect_path(rr), ClipperLib::ptClip, true);
-    ClipperLib::PolyTree tree;
-    c.Execute(ClipperLib::ctIntersection, tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-    detail::append_polygons(tree, polys);
+    switch (circle_vs_rect(rr, circle.size())) {
+      case CircleCover::Outside:
+        break;
+      case CircleCover::Inside: {
+        Polygon p;
+        p.outer.pts = detail::rect_path(rr);
+        p.bbox = rr;
+        polys.push_back(std::move(p));
+        break;
+      }
+      case CircleCover::Crossed: {
+        // Only the part of the outline near the region enters Clipper (cut_to_rect keeps it
+        // vertex for vertex inside the region): a 4096-gon per region made a many-region
+        // cylinder take seconds to build, and the levels file reader with it (fuzz_lbrs).
+        detail::cut_to_rect(circle, rr, cut, tmp);
+        ClipperLib::Clipper c;
+        c.AddPath(cut, ClipperLib::ptSubject, true);
+        c.AddPath(detail::rect_path(rr), ClipperLib::ptClip, true);
+        ClipperLib::PolyTree tree;
+        c.Execute(ClipperLib::ctIntersection, tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+        detail::append_polygons(tree, polys);
+        break;
+      }
+    }
   }
   return polys;
+}
+
+LbrSolid::CircleCover LbrSolid::circle_vs_rect(const Rect& rr, std::size_t segs) const noexcept {
+  if (rr.x0 >= rr.x1 || rr.y0 >= rr.y1 || segs < 3) return CircleCover::Crossed;  // as Clipper decides
+  // stock_circle()'s polygon before rounding has circumradius rho and inradius rho cos(pi/segs);
+  // rounding moves each vertex by < 1 unit, so a point 2 units inside the inradius (outside
+  // the circumradius) keeps its winding number 1 (0): the region is wholly in (out of) the stock.
+  const CylinderStock& c = spec_.cylinder;
+  const double r = 0.5 * c.diameter_mm * kUnitsPerMm;
+  const double pi_n = std::numbers::pi / static_cast<double>(segs);
+  const double rho = r * 2.0 / (1.0 + std::cos(pi_n));
+  const double cx = c.center_x_mm * kUnitsPerMm, cy = c.center_y_mm * kUnitsPerMm;
+  const double x0 = static_cast<double>(rr.x0) - cx, x1 = static_cast<double>(rr.x1) - cx;
+  const double y0 = static_cast<double>(rr.y0) - cy, y1 = static_cast<double>(rr.y1) - cy;
+  const double fx = std::max(std::abs(x0), std::abs(x1)), fy = std::max(std::abs(y0), std::abs(y1));  // farthest corner
+  if (std::hypot(fx, fy) <= rho * std::cos(pi_n) - 2.0) return CircleCover::Inside;
+  const double nx = std::max({x0, -x1, 0.0}), ny = std::max({y0, -y1, 0.0});  // nearest point
+  if (std::hypot(nx, ny) >= rho + 2.0) return CircleCover::Outside;
+  return CircleCover::Crossed;
 }
 
 double LbrSolid::level_bottom_mm(int level) const noexcept { return z0_ + level * spec_.level_spacing_mm; }
