@@ -764,14 +764,23 @@ bool beside_material(const Hull3& hull, const Circle* c, int n, const Rect& m) n
 }
 
 
-// The coarse points of piece p (its kDirs directions, cold brackets) and Q's half-planes.
-void coarse_section(const Hull3& hull, double tol, TiltedPiece& p) {
+// The coarse points of piece p (its kDirs directions) and Q's half-planes. Each direction's
+// search starts from the previous piece's final bracket in the same direction when there is
+// one (`prev`: the sub-step before on the same plane, whose tilt there differs little), else
+// from the last direction's (the first from [−1, 1], with at least 5 steps).
+void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, TiltedPiece& p) {
   constexpr int n = TiltedPiece::kDirs;
   const double eps = kPointEps * tol;
   double tlo = -1.0, thi = 1.0;
   for (int i = 0; i < n; ++i) {
     const double phi = 2.0 * std::numbers::pi * i / n;
-    const P2 q = hull.section_point(phi, p.zc, eps, tlo, thi, 4);
+    int min_steps = 4;
+    if (prev != nullptr) {
+      tlo = prev->dirs[i].t_lo;
+      thi = prev->dirs[i].t_hi;
+      min_steps = 1;
+    }
+    const P2 q = hull.section_point(phi, p.zc, eps, tlo, thi, min_steps);
     p.dirs[i] = {phi, q, tlo, thi};
   }
   p.edge_count = 0;
@@ -826,12 +835,13 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
     if (zc < zlo || zc > zhi) continue;
     const Hull3 hull{&s, {pa, b}};
     if (material != nullptr && beside_material(hull, circles, nc, *material)) continue;
+    const bool warm = !out.empty() && out.back().zc == zc;
     out.emplace_back();
     TiltedPiece& p = out.back();
     p.a = pa;
     p.b = b;
     p.zc = zc;
-    coarse_section(hull, s.chord_tol_mm, p);
+    coarse_section(hull, s.chord_tol_mm, warm ? &out[out.size() - 2] : nullptr, p);
     ++added;
   }
   return added;
