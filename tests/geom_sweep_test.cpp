@@ -311,3 +311,55 @@ TEST(Sweep, TrimCoveredKeepsTheUnionOfConsecutiveSections) {
   EXPECT_EQ(kept, b[0]);
   EXPECT_EQ(dropped, 0);  // consecutive moves share a boundary, so none of the random ones
 }
+
+TEST(Sweep, TiltedPiecesWithNeighbourCoversKeepTheUnionWithFewerVertices) {
+  // A ball Ø6 along X in 0.5 mm moves, its axis tilting by 1° per move (two sub-steps each),
+  // cut by one plane through the ball and one through the shank. Each piece refined only
+  // where neither neighbour's coarse polygon covers it (the engine's way) must give the same
+  // union as every piece refined in full, with far fewer vertices.
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  auto pose = [](int i) {
+    const double a = (1.0 * i) * test::kPi / 180.0;
+    return test::at(0.5 * i, 0, 0, {0, -std::sin(a), std::cos(a)});
+  };
+  std::vector<geom::Sweep> sweeps;
+  for (int i = 0; i < 12; ++i) sweeps.emplace_back(shape, pose(i), pose(i + 1));
+  auto union_area = [](const geom::Paths& ps) {
+    ClipperLib::Clipper c;
+    c.AddPaths(ps, ClipperLib::ptSubject, true);
+    geom::Paths u;
+    c.Execute(ClipperLib::ctUnion, u, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+    double a = 0.0;
+    for (const auto& p : u) a += ClipperLib::Area(p);
+    return geom::area_to_mm2(a);
+  };
+  for (double z : {1.5, 8.0}) {
+    std::vector<geom::TiltedPiece> pieces;
+    for (std::uint32_t k = 0; k < sweeps.size(); ++k) {
+      const std::size_t before = pieces.size();
+      sweeps[k].tilted_pieces(z, pieces);
+      for (std::size_t i = before; i < pieces.size(); ++i) pieces[i].sweep = k;
+    }
+    ASSERT_GE(pieces.size(), sweeps.size()) << "z " << z;  // a sub-step or two per move
+    geom::SectionScratch sc;
+    geom::Paths covered, full;
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      const auto& sw = sweeps[pieces[i].sweep];
+      sw.build_piece(pieces[i], i > 0 ? &pieces[i - 1] : nullptr, i + 1 < pieces.size() ? &pieces[i + 1] : nullptr, covered, sc);
+      sw.build_piece(pieces[i], nullptr, nullptr, full, sc);
+    }
+    ASSERT_EQ(full.size(), pieces.size());
+    std::size_t vc = 0, vf = 0;
+    for (const auto& p : covered) vc += p.size();
+    for (const auto& p : full) vf += p.size();
+    EXPECT_LT(vc * 2, vf) << "z " << z << ": " << vc << " vertices with covers, " << vf << " without";
+    // Perimeter of the union about 2 · 6.5 + 2π · 3.3 mm; chord tolerance on it.
+    const double af = union_area(full), ac = union_area(covered);
+    EXPECT_GT(af, 30.0);
+    EXPECT_NEAR(ac, af, 40.0 * kTol) << "z " << z;
+    // The same with one piece's neighbours missing: its own arcs are then refined in full.
+    geom::Paths alone;
+    sweeps[pieces[5].sweep].build_piece(pieces[5], nullptr, nullptr, alone, sc);
+    EXPECT_NEAR(union_area(alone), union_area(geom::Paths{full[5]}), 1e-9);
+  }
+}

@@ -123,12 +123,10 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
       ls.all.add(ls.box.back());
     }
   };
-  // Tilted sections wait in ls.paths beyond ls.box (no boxes yet) until join_tilted().
-  MoveId tilted_id = 0;
-  auto flush_tilted = [&] {
-    if (ls.paths.size() > ls.box.size()) join_tilted(ls.box.size(), tilted_id, ws, ls, stats);
-    tilted_id = 0;
-  };
+  // Tilted sweeps' pieces (sub-steps) wait in ws.pieces until the run's next vertical sweep
+  // or its end (build_tilted()).
+  ws.pieces.clear();
+  auto flush_tilted = [&] { build_tilted(sh, ws, ls, stats); };
   std::uint32_t si = run.first;
   while (si < run.second) {
     const Sweep& sw = sh.sweeps[si];
@@ -137,11 +135,9 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
       continue;
     }
     if (!sw.vertical()) {
-      const std::size_t before = ls.paths.size();
-      sw.section(zc, ls.paths, ws.scratch, &material);
-      trim_tilted(si, before, sh, ws, ls, stats);
-      if (ls.paths.size() > before) tilted_id = std::max(tilted_id, sh.sweep_id[si]);
-      if (ls.paths.size() - ls.box.size() >= kTiltedGroup) flush_tilted();
+      const std::size_t before = ws.pieces.size();
+      sw.tilted_pieces(zc, ws.pieces, &material);
+      for (std::size_t k = before; k < ws.pieces.size(); ++k) ws.pieces[k].sweep = si;
       ++si;
       continue;
     }
@@ -194,6 +190,30 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
   flush_tilted();
 }
 
+// The sections of the pending tilted pieces (ws.pieces, consecutive sub-steps of a run's
+// tilted sweeps on this level), each refined only where neither neighbour's coarse polygon
+// covers its arcs (Sweep::build_piece(): all of them go into this level's one difference),
+// then trimmed by the previous one (trim_tilted()) and joined in groups (join_tilted()).
+void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
+                                  SubtractStats& stats) const {
+  const std::size_t n = ws.pieces.size();
+  MoveId id = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const TiltedPiece& p = ws.pieces[i];
+    const std::size_t before = ls.paths.size();
+    sh.sweeps[p.sweep].build_piece(p, i > 0 ? &ws.pieces[i - 1] : nullptr, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
+                                   ls.paths, ws.scratch);
+    trim_tilted(p.sweep, before, sh, ws, ls, stats);
+    if (ls.paths.size() > before) id = std::max(id, sh.sweep_id[p.sweep]);
+    if (ls.paths.size() - ls.box.size() >= kTiltedGroup) {
+      join_tilted(ls.box.size(), id, ws, ls, stats);
+      id = 0;
+    }
+  }
+  if (ls.paths.size() > ls.box.size()) join_tilted(ls.box.size(), id, ws, ls, stats);
+  ws.pieces.clear();
+}
+
 // The tilted sections ls.paths[begin..] (consecutive sub-steps and moves of one run, each
 // convex) become their union, with id `id` (the latest move among them). Fed to a clip as
 // separate polygons, neighbours that overlap put all their edges into every scan beam; a
@@ -230,8 +250,9 @@ void SubtractEngine::join_tilted(std::size_t begin, MoveId id, SubtractWorkspace
 void SubtractEngine::trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
                            LevelSections& ls, SubtractStats& stats) const {
   const Sweep& sw = sh.sweeps[si];
-  bool covered = ws.prev_tilted_valid && ws.prev_tilted_sweep + 1 == si &&
-                 &sh.sweeps[si - 1].shape() == &sw.shape() && sh.sweeps[si - 1].to().tip == sw.from().tip;
+  bool covered = ws.prev_tilted_valid &&
+                 (ws.prev_tilted_sweep == si || (ws.prev_tilted_sweep + 1 == si && &sh.sweeps[si - 1].shape() == &sw.shape() &&
+                                                 sh.sweeps[si - 1].to().tip == sw.from().tip));
   std::size_t w = before;
   for (std::size_t k = before; k < ls.paths.size(); ++k) {
     ws.tilted_next = ls.paths[k];

@@ -56,6 +56,7 @@ class SubtractEngine {
                    SubtractStats& stats) const;
   void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const Rect& material,
                           const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
+  void build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   static void join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats);
   void trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
                    LevelSections& ls, SubtractStats& stats) const;

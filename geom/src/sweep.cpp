@@ -656,20 +656,26 @@ const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {
 
 namespace {
 
-// The boundary of the section of `hull` on z = zc, as support points in angular order
-// (counter-clockwise) appended to sc.pts. Between the support points a and b of directions
-// φa < φb the boundary lies in the triangle of the chord ab and the two support lines
-// (convexity), whose height over the chord is at most |ab|/2 · tan((φb − φa)/2) (base
-// angles summing to φb − φa). An interval is split at its middle direction until that
-// bound is within tol/2, so every vertex is evaluated once and kept; a middle point on the
-// chord (within the point accuracy) proves the boundary straight there (the support line
-// through it holds a and b) and ends the split as well.
-void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc) {
-  constexpr double kPointEps = 0.05;  // boundary points to tol/20
-  constexpr int kStart = 16;
+constexpr double kPointEps = 0.05;  // boundary points to tol/20 (of the chord tolerance)
+
+// The boundary of the section of piece p's hull on its plane, as support points in angular
+// order (counter-clockwise) appended to sc.pts, starting from the piece's coarse points.
+// Between the support points a and b of directions φa < φb the boundary lies in the
+// triangle of the chord ab and the two support lines (convexity), whose height over the
+// chord is at most |ab|/2 · tan((φb − φa)/2) (base angles summing to φb − φa). An interval
+// is split at its middle direction until that bound is within tol/2, so every vertex is
+// evaluated once and kept; a middle point on the chord (within the point accuracy) proves
+// the boundary straight there (the support line through it holds a and b) and ends the
+// split as well. So does a triangle (support lines moved out by the point accuracy) that
+// lies inside a cover's coarse polygon: what the chord leaves out there is removed by the
+// cover's own polygon.
+void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const TiltedPiece* cover0,
+                    const TiltedPiece* cover1, SectionScratch& sc) {
+  constexpr int kStart = TiltedPiece::kDirs;
   constexpr int kMaxPoints = 8192;
   constexpr int kWarmSteps = 1;  // a middle direction starts from its neighbours' brackets
   const double eps = kPointEps * tol;
+  const double zc = p.zc;
   struct Iv {
     double pa, pb;
     P2 a, b;
@@ -684,26 +690,34 @@ void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc
     for (int d = 0; d < kDepths; ++d) t[static_cast<std::size_t>(d)] = std::tan(std::numbers::pi / kStart / std::ldexp(1.0, d));
     return t;
   }();
-  sc.dirs.clear();
-  double tlo = -1.0, thi = 1.0;
-  for (int i = 0; i < kStart; ++i) {
-    const double phi = 2.0 * std::numbers::pi * i / kStart;
-    const P2 p = hull.section_point(phi, zc, eps, tlo, thi, 4);
-    sc.dirs.push_back({phi, p, tlo, thi});
-  }
+  // The triangle of interval iv lies inside a cover (its three corners do; margin: the
+  // point accuracy and a kernel unit for the rounding of the cover's polygon).
+  const double margin = eps + 1.0 / kUnitsPerMm;
+  auto covered = [&](const Iv& iv) {
+    if (cover0 == nullptr && cover1 == nullptr) return false;
+    const double ax = std::cos(iv.pa), ay = std::sin(iv.pa), bx = std::cos(iv.pb), by = std::sin(iv.pb);
+    const double ha = ax * iv.a.x + ay * iv.a.y + eps, hb = bx * iv.b.x + by * iv.b.y + eps;
+    const double det = ax * by - ay * bx;  // sin(φb − φa) > 0
+    if (!(det > 1e-12)) return false;
+    const P2 apex{(ha * by - hb * ay) / det, (ax * hb - bx * ha) / det};
+    for (const TiltedPiece* c : {cover0, cover1})
+      if (c != nullptr && c->covers(iv.a, margin) && c->covers(iv.b, margin) && c->covers(apex, margin)) return true;
+    return false;
+  };
   sc.pts.clear();
   for (int i = 0; i < kStart; ++i) {
     const int j = (i + 1) % kStart;
+    const auto& di = p.dirs[i];
+    const auto& dj = p.dirs[j];
     Iv stack[64];
     int sp = 0;
-    stack[sp++] = {sc.dirs[i].phi, sc.dirs[i].phi + 2.0 * std::numbers::pi / kStart, sc.dirs[i].p, sc.dirs[j].p,
-                   sc.dirs[i].t_lo, sc.dirs[i].t_hi, sc.dirs[j].t_lo, sc.dirs[j].t_hi, 0};
+    stack[sp++] = {di.phi, di.phi + 2.0 * std::numbers::pi / kStart, di.p, dj.p, di.t_lo, di.t_hi, dj.t_lo, dj.t_hi, 0};
     while (sp > 0) {
       const Iv iv = stack[--sp];
       const double dx = iv.b.x - iv.a.x, dy = iv.b.y - iv.a.y;
       const double bound = 0.5 * tan_half[static_cast<std::size_t>(std::min(iv.depth, kDepths - 1))];  // |ab|/2 · tan(Δφ/2) / |ab|
       if (iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
-          bound * bound * (dx * dx + dy * dy) <= 0.25 * tol * tol) {
+          bound * bound * (dx * dx + dy * dy) <= 0.25 * tol * tol || covered(iv)) {
         sc.pts.push_back(iv.a);
         continue;
       }
@@ -720,10 +734,6 @@ void refine_section(const Hull3& hull, double zc, double tol, SectionScratch& sc
     }
   }
 }
-
-}  // namespace
-
-namespace {
 
 // True when the sub-step's hull (circles c[0..n)) certainly misses the material box `m`
 // [units] in XY: their boxes are apart, or the horizontal direction u from the box's
@@ -753,15 +763,60 @@ bool beside_material(const Hull3& hull, const Circle* c, int n, const Rect& m) n
   return hull_min > box_max;
 }
 
+
+// The coarse points of piece p (its kDirs directions) and Q's half-planes. Each direction's
+// search starts from the previous piece's final bracket in the same direction when there is
+// one (`prev`: the sub-step before on the same plane, whose tilt there differs little), else
+// from the last direction's (the first from [−1, 1], with at least 5 steps).
+void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, TiltedPiece& p) {
+  constexpr int n = TiltedPiece::kDirs;
+  const double eps = kPointEps * tol;
+  double tlo = -1.0, thi = 1.0;
+  for (int i = 0; i < n; ++i) {
+    const double phi = 2.0 * std::numbers::pi * i / n;
+    int min_steps = 4;
+    if (prev != nullptr) {
+      tlo = prev->dirs[i].t_lo;
+      thi = prev->dirs[i].t_hi;
+      min_steps = 1;
+    }
+    const P2 q = hull.section_point(phi, p.zc, eps, tlo, thi, min_steps);
+    p.dirs[i] = {phi, q, tlo, thi};
+  }
+  p.edge_count = 0;
+  p.x0 = p.x1 = p.dirs[0].p.x;
+  p.y0 = p.y1 = p.dirs[0].p.y;
+  for (int i = 0; i < n; ++i) {
+    const P2 a = p.dirs[i].p, b = p.dirs[(i + 1) % n].p;
+    p.x0 = std::min(p.x0, a.x);
+    p.x1 = std::max(p.x1, a.x);
+    p.y0 = std::min(p.y0, a.y);
+    p.y1 = std::max(p.y1, a.y);
+    const double ex = b.x - a.x, ey = b.y - a.y, l = std::hypot(ex, ey);
+    if (!(l > 1e-9)) continue;  // coinciding points: no edge
+    const double nx = ey / l, ny = -ex / l;  // outward for a counter-clockwise polygon
+    p.edges[p.edge_count++] = {nx, ny, nx * a.x + ny * a.y};
+  }
+  if (p.edge_count < 3) p.edge_count = 0;  // no area: covers nothing
+}
+
 }  // namespace
 
-std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc, const Rect* material) const {
+bool TiltedPiece::covers(const SectionScratch::P2& q, double margin_mm) const noexcept {
+  if (edge_count == 0 || q.x <= x0 || q.x >= x1 || q.y <= y0 || q.y >= y1) return false;
+  for (int i = 0; i < edge_count; ++i)
+    if (edges[i].nx * q.x + edges[i].ny * q.y > edges[i].c - margin_mm) return false;
+  return true;
+}
+
+std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const Rect* material) const {
+  if (vertical_ || zc < box_.lo.z || zc > box_.hi.z) return 0;
   const CutterShape& s = *shape_;
   const int ns = static_cast<int>(s.stations.size());
   constexpr int kMaxStations = 512;
   Circle circles[2 * kMaxStations];
   if (ns > kMaxStations) return 0;
-  std::size_t emitted = 0;
+  std::size_t added = 0;
   Pose a{from_.tip, from_.axis};
   for (int k = 1; k <= substeps_; ++k) {
     const double t = static_cast<double>(k) / substeps_;
@@ -780,10 +835,32 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc, co
     if (zc < zlo || zc > zhi) continue;
     const Hull3 hull{&s, {pa, b}};
     if (material != nullptr && beside_material(hull, circles, nc, *material)) continue;
-    refine_section(hull, zc, s.chord_tol_mm, sc);
-    convex_hull(sc.pts, sc.hull);
-    emitted += emit(sc.hull, out, sc.spare);
+    const bool warm = !out.empty() && out.back().zc == zc;
+    out.emplace_back();
+    TiltedPiece& p = out.back();
+    p.a = pa;
+    p.b = b;
+    p.zc = zc;
+    coarse_section(hull, s.chord_tol_mm, warm ? &out[out.size() - 2] : nullptr, p);
+    ++added;
   }
+  return added;
+}
+
+std::size_t Sweep::build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
+                               SectionScratch& sc) const {
+  const Hull3 hull{shape_, {p.a, p.b}};
+  refine_section(hull, p, shape_->chord_tol_mm, cover0, cover1, sc);
+  convex_hull(sc.pts, sc.hull);
+  return emit(sc.hull, out, sc.spare);
+}
+
+// Each sub-step on its own (no covers): every polygon is its sub-step's whole section.
+std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc, const Rect* material) const {
+  sc.pieces.clear();
+  tilted_pieces(zc, sc.pieces, material);
+  std::size_t emitted = 0;
+  for (const TiltedPiece& p : sc.pieces) emitted += build_piece(p, nullptr, nullptr, out, sc);
   return emitted;
 }
 

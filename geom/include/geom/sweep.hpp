@@ -29,6 +29,8 @@ struct Capsule {
   [[nodiscard]] bool valid() const noexcept { return r1 >= 0.0 && r2 >= 0.0; }
 };
 
+struct TiltedPiece;
+
 // Reusable buffers for Sweep::section(); grows to the largest section seen, then stops
 // allocating. One per thread.
 struct SectionScratch {
@@ -54,6 +56,7 @@ struct SectionScratch {
     double t_lo, t_hi;  // the bracket of the 3D direction's tilt that found p (section_general)
   };
   std::vector<Dir> dirs;
+  std::vector<TiltedPiece> pieces;  // a tilted sweep's sub-steps on the plane (section())
   // Set by each vertical section: a capsule inside the polygon just emitted (invalid when
   // the last section was empty or came from the general path).
   Capsule core;
@@ -84,6 +87,27 @@ struct MoveCaps {
   double rho0 = 0.0, rho1 = 0.0;
   int back_l = 0, back_r = 0, front_r = 0, front_l = 0;
   std::vector<SectionScratch::P2> right, left;
+};
+
+// One sub-step of a tilted sweep (Sweep::tilted_pieces()) cut by one plane, with its coarse
+// section: the boundary points in kDirs equally spaced directions, whose polygon Q lies
+// inside the section (each point is interpolated inside the hull). Q, as half-planes, is
+// what a neighbouring piece's refinement tests its unrefined arcs against
+// (Sweep::build_piece()).
+struct TiltedPiece {
+  static constexpr int kDirs = 16;
+  Pose a, b;  // the sub-step's poses
+  double zc = 0.0;
+  std::uint32_t sweep = 0;  // caller's index of the sweep it belongs to
+  SectionScratch::Dir dirs[kDirs];
+  // Q's edges of non-zero length: inside Q by at least `margin` <=> nx·x + ny·y <= c - margin.
+  struct Edge {
+    double nx, ny, c;
+  };
+  Edge edges[kDirs];
+  int edge_count = 0;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // Q's box [mm]
+  [[nodiscard]] bool covers(const SectionScratch::P2& p, double margin_mm) const noexcept;
 };
 
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
@@ -126,6 +150,21 @@ class Sweep {
   // radius, or the move does not move in XY); `out` is then unspecified. Real-time safe once
   // the buffers have grown.
   bool section_caps(double z_mm, int n, SectionScratch& scratch, MoveCaps& out) const;
+
+  // Tilted sweeps only: appends to `out` one TiltedPiece per sub-step whose hull meets plane
+  // z = z_mm and, when `material` is given, does not lie beside it (as section()); returns
+  // how many. Real-time safe once `out` has grown.
+  std::size_t tilted_pieces(double z_mm, std::vector<TiltedPiece>& out, const Rect* material = nullptr) const;
+  // The section of piece `p` as one convex polygon appended to `out` (counter-clockwise,
+  // kernel units); returns 1, or 0 when it has no area. Its boundary is refined to the chord
+  // tolerance except on arcs whose refinement triangle (docs/lbr-conventions.md, "Sweeps and
+  // sections") lies inside the coarse polygon of `cover0` or `cover1` (pieces of the same
+  // plane, or null): there the polygon keeps only the coarse points, and is exact only
+  // together with those pieces' own polygons, which contain their coarse polygons. So the
+  // polygons of a sequence of pieces, each built with its neighbours as covers, have the
+  // union of their sections within the chord tolerance when removed in one difference.
+  std::size_t build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
+                          SectionScratch& scratch) const;
 
   static constexpr int kMaxTiltSubsteps = 256;  // sub-steps of one sweep whose tool axis turns (kin::kMaxMoveSubsteps: pieces of a move)
 
