@@ -184,9 +184,12 @@ constexpr std::int64_t kDutyBurstNs = 200'000'000;
 // the same cells (measured: busy 63–69 % of the time at 1 kHz on finish3d, calls of one
 // sweep, and held at the duty limit, where the rests build a backlog). It waits instead
 // until the oldest queued sample is kGatherFactor × the recent tick time old (the EWMA of
-// the work per tick), at most kGatherMaxNs: work per tick c, gathered for 2c, keeps the
-// thread about half busy, and a sample's lag stays within the gather time plus one tick.
-constexpr double kGatherFactor = 2.0;
+// the work per tick), at most kGatherMaxNs: work per tick c, gathered for 4c, keeps the
+// thread at most a quarter busy where it can, and a sample's lag stays within the gather
+// time plus one tick. Measured on helix (16x16 cells, 1 kHz): gathering 2c (≈ 1 ms) made
+// 97 k kernel calls busy for 70 s and lag p99 19.7 ms; gathering 2.5 ms, 59 k calls, 53 s,
+// p99 13.0 ms (docs/performance.md "Live lag").
+constexpr double kGatherFactor = 4.0;
 constexpr std::int64_t kGatherMaxNs = 2'500'000;
 constexpr double kTickEwmaWeight = 0.1;
 
