@@ -29,6 +29,7 @@ Geometry::Geometry(geom::LbrSolid& solid, const Profile& profile, const motion::
   seq_.resize(ring.capacity());
   chan_.resize(ring.capacity());
   weight_.resize(ring.capacity());
+  prefix_units_.resize(batch_capacity(ring.capacity()));
   const std::size_t cells = static_cast<std::size_t>(solid.levels()) * static_cast<std::size_t>(solid.regions());
   if (cells <= (std::size_t{1} << 22)) stamp_.assign(cells, 0);  // else: cells counted per sweep
 }
@@ -258,6 +259,7 @@ std::size_t Geometry::sub_batch(std::span<const geom::SweepRef> batch, std::size
     part = probe;
     part.units += u;
     if (j == i) part.first = u;
+    if (j - i < prefix_units_.size()) prefix_units_[j - i] = part.units;
   }
   return j;
 }
@@ -275,7 +277,7 @@ bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
     // it are subtracted).
     j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
     j = checked(i, j);
-    if (j == i + 1) part.units = part.first;
+    if (j - i - 1 < prefix_units_.size()) part.units = prefix_units_[j - i - 1];  // the sweeps it keeps
     const int k = j > i + 1 ? 1
                   : timed_  ? sizer_.pieces(part.first, part.target_ns, kMaxPieces)
                   : part.first > budget_ ? std::min(kMaxPieces, static_cast<int>(std::ceil(part.first / budget_)))

@@ -190,6 +190,7 @@ class Geometry final : public motion::SweepSink {
   double budget_ = 60'000.0;
   bool timed_ = false;
   CallSizer sizer_;
+  std::vector<double> prefix_units_;  // sub_batch(): units of its first k + 1 sweeps
   std::size_t lag_done_ = 0;  // ring entries of this tick whose lag is recorded
   std::array<std::uint64_t, hal::kMaxChannels> done_seq_{};  // per channel: applied up to this sample
   std::array<bool, hal::kMaxChannels> done_any_{};
