@@ -57,7 +57,7 @@ TEST(BundledProfiles, DefaultMill3) {
   EXPECT_EQ(p.tooling.tools.at(2).holder_diameter_mm, 40.0);
   EXPECT_EQ(p.tooling.mount_of(1), kin::Mount::Spindle);
   EXPECT_TRUE(p.tooling.inserts.empty());
-  EXPECT_TRUE(p.live_grid.set);                                          // app [live] regions
+  EXPECT_TRUE(p.live_grid.set);                                          // app [lbr] live_regions
   EXPECT_FALSE(p.live_grid.automatic);
   EXPECT_EQ(p.live_grid.x, 16);
   EXPECT_EQ(p.live_grid.y, 16);

@@ -129,7 +129,7 @@ TEST(LiveRun, EmulatorWithToolChangesMatchesBatch) {
 }
 
 TEST(LiveRun, TheLiveSolidHasTheLiveRegionGrid) {
-  // [live] regions (the default profile: 16x16) for `lbrsim run`; without it, [lbr] regions.
+  // [lbr] live_regions (the default profile: 16x16) for `lbrsim run`; without it, [lbr] regions.
   app::Profile p = app::default_profile();
   ASSERT_TRUE(p.live_grid.set);
   const app::LiveResult a = run_emulated(p, kShortProgram, "lbr_live_grid", "short.moves");

@@ -49,8 +49,8 @@ struct Profile {
   int threads = 0;             // [lbr] batch-mode kernel threads (0 = one per hardware thread)
   motion::ToolsConfig tooling; // [[tool]]: milling tools, lathe inserts, live-tool mounts (motion/config_toml.hpp)
   hal::LiveConfig live;        // [live], [[live.axis]], [threads]: `lbrsim run` (hal/config_toml.hpp)
-  // [live] regions: the region grid of `lbrsim run`'s solid when it differs from [lbr]'s
-  // (set = false: [lbr] regions). A live kernel call clips every cell a sweep reaches, whole,
+  // [lbr] live_regions: the region grid of `lbrsim run`'s solid when it differs from
+  // [lbr] regions (set = false: the same). A live kernel call clips every cell a sweep reaches, whole,
   // so smaller cells make the short calls of a live run cheaper (docs/performance.md "Live lag").
   struct LiveGrid {
     bool set = false, automatic = false;

@@ -212,6 +212,7 @@ bool Geometry::apply_pieces(const geom::SweepRef& s, int k, const Part& info) no
 
 double Geometry::added_units(const geom::SweepRef& s, Part& part) noexcept {
   Reach r;
+  part.sections = 0.0;
   if (!reach(s, r)) return 1.0;
   const double levels = r.l1 - r.l0 + 1;
   double cells = 0.0;
@@ -236,7 +237,8 @@ double Geometry::added_units(const geom::SweepRef& s, Part& part) noexcept {
         }
       }
   }
-  return kSectionUnits * levels * r.tilt + kCellUnits * cells;
+  part.sections = kSectionUnits * levels * r.tilt;
+  return part.sections + kCellUnits * cells;
 }
 
 std::size_t Geometry::sub_batch(std::span<const geom::SweepRef> batch, std::size_t i, Part& part) noexcept {
@@ -258,7 +260,7 @@ std::size_t Geometry::sub_batch(std::span<const geom::SweepRef> batch, std::size
     if (j > i && part.units + u > budget) break;
     part = probe;
     part.units += u;
-    if (j == i) part.first = u;
+    if (j == i) part.first = u, part.first_sections = probe.sections;
     if (j - i < prefix_units_.size()) prefix_units_[j - i] = part.units;
   }
   return j;
@@ -278,8 +280,10 @@ bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
     j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
     j = checked(i, j);
     if (j - i - 1 < prefix_units_.size()) part.units = prefix_units_[j - i - 1];  // the sweeps it keeps
+    // Timed calls cut a sweep only for its sections (a turning tool axis): every piece
+    // clips the same cells, so cutting a sweep whose cost is its cells multiplies it.
     const int k = j > i + 1 ? 1
-                  : timed_  ? sizer_.pieces(part.first, part.target_ns, kMaxPieces)
+                  : timed_  ? sizer_.pieces(part.first_sections, part.target_ns, kMaxPieces)
                   : part.first > budget_ ? std::min(kMaxPieces, static_cast<int>(std::ceil(part.first / budget_)))
                                          : 1;
     if (k > 1) {  // one sweep over the budget: cut into pieces

@@ -151,6 +151,8 @@ class Geometry final : public motion::SweepSink {
   struct Part {
     double units = 0.0;          // work estimate, cells once
     double first = 0.0;          // of its first sweep alone
+    double first_sections = 0.0; // of its first sweep's sections (what pieces share out)
+    double sections = 0.0;       // added_units(): of the last sweep's sections
     double cell_vertices = 0.0;  // only with a kernel log
     std::int64_t target_ns = 0;  // the call time it was sized for (timed calls)
     std::int64_t backlog_ns = 0;

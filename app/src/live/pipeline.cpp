@@ -455,7 +455,7 @@ void configure_program(LivePipeline::Impl& p) {
 geom::SolidSpec live_solid_spec(const Profile& profile, const motion::ToolTable& tools) {
   geom::SolidSpec spec = profile.solid;
   bool automatic = profile.regions_auto;
-  if (profile.live_grid.set) {  // [live] regions
+  if (profile.live_grid.set) {  // [lbr] live_regions
     automatic = profile.live_grid.automatic;
     if (!automatic) spec.regions_x = profile.live_grid.x, spec.regions_y = profile.live_grid.y;
   }
