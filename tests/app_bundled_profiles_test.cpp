@@ -57,6 +57,10 @@ TEST(BundledProfiles, DefaultMill3) {
   EXPECT_EQ(p.tooling.tools.at(2).holder_diameter_mm, 40.0);
   EXPECT_EQ(p.tooling.mount_of(1), kin::Mount::Spindle);
   EXPECT_TRUE(p.tooling.inserts.empty());
+  EXPECT_TRUE(p.live_grid.set);                                          // app [lbr] live_regions
+  EXPECT_FALSE(p.live_grid.automatic);
+  EXPECT_EQ(p.live_grid.x, 16);
+  EXPECT_EQ(p.live_grid.y, 16);
   EXPECT_EQ(p.live.period_ms, 1.0);                                      // hal defaults
   EXPECT_EQ(p.live.axes.size(), 3u);
   EXPECT_EQ(p.live.hal_thread.priority, 80);                             // sched defaults
@@ -69,6 +73,7 @@ TEST(BundledProfiles, DefaultMill3) {
   EXPECT_EQ(d.name, p.name);
   EXPECT_EQ(d.tooling.tools.size(), p.tooling.tools.size());
   EXPECT_EQ(d.machine.g54_origin_mm, p.machine.g54_origin_mm);
+  EXPECT_EQ(d.live_grid.x, p.live_grid.x);
 }
 
 TEST(BundledProfiles, Mill5AC) {

@@ -128,6 +128,50 @@ TEST(LiveRun, EmulatorWithToolChangesMatchesBatch) {
   EXPECT_GT(b.removed_volume_mm3, 100.0);
 }
 
+TEST(LiveRun, TheLiveSolidHasTheLiveRegionGrid) {
+  // [lbr] live_regions (the default profile: 16x16) for `lbrsim run`; without it, [lbr] regions.
+  app::Profile p = app::default_profile();
+  ASSERT_TRUE(p.live_grid.set);
+  const app::LiveResult a = run_emulated(p, kShortProgram, "lbr_live_grid", "short.moves");
+  EXPECT_EQ(a.solid.regions_x(), 16);
+  EXPECT_EQ(a.solid.regions_y(), 16);
+  p.live_grid.set = false;
+  const app::LiveResult b = run_emulated(p, kShortProgram, "lbr_live_grid", "short.moves");
+  EXPECT_EQ(b.solid.regions_x(), p.solid.regions_x);
+  EXPECT_NEAR(a.removed_volume_mm3, b.removed_volume_mm3, 5e-4 * b.removed_volume_mm3);
+}
+
+TEST(LiveRun, APacedRunRecordsEachKernelCallAndTheSamplesItCompleted) {
+  // A live (paced) source: calls sized by time; the kernel log holds every call, and the
+  // samples whose lag was taken at the end of their own call add up to nearly all of them
+  // (the rest: a channel's first sample, a pose, recorded at the end of the tick).
+  const app::Profile p = app::default_profile();
+  const std::string dir = testing::TempDir() + "/lbr_live_log";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/short.moves") << kShortProgram;
+  std::atomic<bool> stop{false};
+  app::LiveOptions o;
+  o.source = "emulator:" + dir + "/short.moves";
+  o.speed = 4.0;
+  o.kernel_log_capacity = 100000;
+  const app::LiveResult r = app::run_live(p, o, stop);
+  EXPECT_EQ(r.samples_lost, 0u);
+  EXPECT_EQ(r.samples_applied, r.samples_received);
+  ASSERT_EQ(r.kernel_log.size(), r.kernel_calls);
+  std::uint64_t completed = 0, sweeps = 0;
+  std::int64_t t_prev = -1;
+  for (const app::KernelCallRecord& k : r.kernel_log) {
+    completed += k.samples;
+    sweeps += k.sweeps;
+    EXPECT_GT(k.sweeps, 0u);
+    EXPECT_GT(k.t_ns, t_prev) << "calls in order";
+    t_prev = k.t_ns;
+  }
+  EXPECT_EQ(sweeps, r.sweeps);
+  EXPECT_LE(completed, r.samples_applied);
+  EXPECT_GE(completed + 10, r.samples_applied);
+}
+
 TEST(LiveRun, StraightRunsMergeIntoOneSweepPerBatch) {
   // One straight cut: every chunk of samples (lbr.batch_moves in a non-live run) is
   // collinear, so each batch subtracts a single sweep, and the volume is the batch volume.
@@ -209,6 +253,9 @@ TEST(LiveRun, CandumpReplayWithFaultsMatchesBatch) {
 
 TEST(LiveRun, StopFlagEndsAPacedRun) {
   app::Profile p = app::default_profile();
+  // [lbr] regions for the live solid: the default live grid's 76 800 cells take seconds to
+  // build under the sanitizers' Debug builds, which this test would time as the stop.
+  p.live_grid.set = false;
   std::atomic<bool> stop{false};
   app::LiveOptions o;
   o.source = "emulator:demo";  // 5+ minutes in real time

@@ -47,6 +47,8 @@ TEST(Profile, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(error_of(kStock + "\n[lbr]\nregions = \"4by4\"\n"),
             "p.toml:7: lbr.regions: expected \"NXxNY\" with 1 <= NX, NY <= 256 (e.g. \"4x4\") or \"auto\", got '4by4'");
   EXPECT_EQ(error_of(kStock + "\n[lbr]\nlevel_spacing = 0.1\n"), "p.toml:7: lbr.level_spacing: unknown key");
+  EXPECT_EQ(error_of(kStock + "\n[lbr]\nlive_regions = \"16\"\n"),
+            "p.toml:7: lbr.live_regions: expected \"NXxNY\" with 1 <= NX, NY <= 256 (e.g. \"4x4\") or \"auto\", got '16'");
   EXPECT_EQ(error_of(kStock + "\n[[tool]]\nnumber = 1\nkind = \"drill\"\n"),
             "p.toml:6: tool.diameter_mm: missing (a number [mm] is required)");
   EXPECT_EQ(error_of(kStock + "\n[[tool]]\nnumber = 1\nkind = \"spoon\"\ndiameter_mm = 3\n"),

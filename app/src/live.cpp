@@ -3,6 +3,7 @@
 #include "app/live.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 #include <thread>
@@ -121,6 +122,17 @@ void write_live_outputs(const std::string& dir, const LiveResult& r, const Profi
   write_file((std::filesystem::path(dir) / "levels.lbrs").string(), geom::to_bytes(r.solid));
   write_file((std::filesystem::path(dir) / "events.csv").string(), verify::events_csv(r.events));
   if (r.design) write_file((std::filesystem::path(dir) / "deviation.csv").string(), verify::deviation_csv(*r.design));
+  if (!r.kernel_log.empty()) {
+    std::string csv = "t_ms,dur_us,sweeps,samples,units,predicted_us,cells_clipped,sections,cell_vertices,backlog_us\n";
+    char line[192];
+    for (const KernelCallRecord& k : r.kernel_log) {
+      std::snprintf(line, sizeof line, "%.3f,%u,%u,%u,%.0f,%.0f,%u,%u,%u,%u\n", static_cast<double>(k.t_ns) * 1e-6, k.dur_us,
+                    k.sweeps, k.samples, static_cast<double>(k.units), static_cast<double>(k.predicted_us), k.cells_clipped,
+                    k.sections, k.cell_vertices, k.backlog_us);
+      csv += line;
+    }
+    write_file((std::filesystem::path(dir) / "kernel_calls.csv").string(), csv);
+  }
 }
 
 nc::EmulatorLimits live_emulator_limits(const Profile& profile) {

@@ -766,6 +766,8 @@ CLI::App* add_run_command(CLI::App& cli, RunOptions& ro) {
       ->capture_default_str();
   run->add_option("--out", ro.out, "Output directory (metrics.json, levels.lbrs)")->capture_default_str();
   run->add_option("--record", ro.live.record, "Record the raw input to this file (candump -l format)");
+  run->add_option("--kernel-log", ro.live.kernel_log_capacity,
+                  "Diagnostics: write OUT/kernel_calls.csv, one line per kernel call (up to N calls)");
   run->add_flag("--resume", ro.resume,
                 "Go on from the newest valid power-loss snapshot in the snapshot folder (a new part when there is none)");
   run->add_option("--snapshot-dir", ro.snapshot_dir,

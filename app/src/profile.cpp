@@ -50,11 +50,25 @@ void read_machine(cfg::Table& s, Profile& p) {
   nc::read_machine(s, p.kin.kind, p.machine);
 }
 
+// [lbr] live_regions: the region grid of `lbrsim run`'s solid.
+void read_live_grid(cfg::Table& s, Profile& p) {
+  const toml::node* r = s.get("live_regions");
+  if (r == nullptr) return;
+  const auto v = r->value_exact<std::string>();
+  if (!v) s.fail(r, "live_regions", "expected a string \"NXxNY\" or \"auto\"");
+  geom::SolidSpec grid;
+  if (const std::string e = geom::apply_regions(*v, grid, p.live_grid.automatic); !e.empty()) s.fail(r, "live_regions", e);
+  p.live_grid.set = true;
+  p.live_grid.x = grid.regions_x;
+  p.live_grid.y = grid.regions_y;
+}
+
 // [lbr]: the kernel's keys (geom) and the batch runner's.
 void read_lbr(cfg::Table& s, Profile& p) {
   geom::read_lbr(s, p.solid, p.regions_auto);
   p.batch_moves = static_cast<int>(s.integer("batch_moves", 512, 1, 100000));
   p.threads = static_cast<int>(s.integer("threads", 0, 0, 256));
+  read_live_grid(s, p);
 }
 
 // [stock] is required.

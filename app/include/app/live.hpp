@@ -41,6 +41,22 @@ struct LiveProgress {
   std::atomic<bool> hal_running{false}, geometry_running{false};
 };
 
+// One kernel call of the live geometry thread (`lbrsim run --kernel-log`, docs/performance.md
+// "Live lag"): when it started [ns since the run's start], how long subtract() took [µs],
+// what it was given and what it did.
+struct KernelCallRecord {
+  std::int64_t t_ns = 0;
+  std::uint32_t dur_us = 0;
+  std::uint32_t sweeps = 0;
+  std::uint32_t samples = 0;       // ring entries whose samples this call completed
+  float units = 0;                 // work estimate (Geometry::work_units, cells once per call)
+  float predicted_us = 0;          // the call sizer's prediction for it
+  std::uint32_t cells_clipped = 0;  // geom::SubtractStats
+  std::uint32_t sections = 0;
+  std::uint32_t cell_vertices = 0;  // vertices of the material cells it reaches (once per call)
+  std::uint32_t backlog_us = 0;    // age of the oldest sample not yet applied, at the call's start
+};
+
 struct LiveOptions {
   std::string source;     // can:IF | serial:DEV | replay:FILE | emulator:PROGRAM
   // The program the machine runs (can, serial, replay): its line is found from the sampled
@@ -73,6 +89,9 @@ struct LiveOptions {
   std::size_t overflow_capacity = 0;
   std::int64_t test_kernel_delay_ns = 0;
   double test_work_budget = 0;  // testing: work budget of one kernel call (0: the default)
+  // Diagnostics: keep a record of up to this many kernel calls (LiveResult::kernel_log;
+  // allocated at setup, the geometry thread only fills it).
+  std::size_t kernel_log_capacity = 0;
   // Power-loss snapshots (app/snapshot.hpp, docs/snapshot.md): written to `snapshot_dir`
   // every profile.live.snapshot_s and when the run ends (none when empty or 0). `resume`:
   // start from this snapshot (stock, channel poses; replay and emulator sources skip the
@@ -133,6 +152,7 @@ struct LiveResult {
   // gouge is not attributed to a sample (the pipeline keeps no move list). A gouge deeper
   // than the tolerance adds a design-gouge event to `events`.
   std::optional<verify::DesignReport> design{};
+  std::vector<KernelCallRecord> kernel_log{};  // LiveOptions::kernel_log_capacity > 0
 };
 
 using StatusFn = std::function<void(const std::string& line)>;

@@ -49,6 +49,13 @@ struct Profile {
   int threads = 0;             // [lbr] batch-mode kernel threads (0 = one per hardware thread)
   motion::ToolsConfig tooling; // [[tool]]: milling tools, lathe inserts, live-tool mounts (motion/config_toml.hpp)
   hal::LiveConfig live;        // [live], [[live.axis]], [threads]: `lbrsim run` (hal/config_toml.hpp)
+  // [lbr] live_regions: the region grid of `lbrsim run`'s solid when it differs from
+  // [lbr] regions (set = false: the same). A live kernel call clips every cell a sweep reaches, whole,
+  // so smaller cells make the short calls of a live run cheaper (docs/performance.md "Live lag").
+  struct LiveGrid {
+    bool set = false, automatic = false;
+    int x = 0, y = 0;
+  } live_grid;
   gfx::RenderThreadConfig render;  // [render]: the render thread's rate (gfx/config_toml.hpp)
   verify::CheckConfig checks;      // [checks]: collision and process checks (verify/config_toml.hpp)
   verify::DesignConfig design;     // batch --design / --tolerance only (no profile key): design-model comparison

@@ -29,6 +29,7 @@ Geometry::Geometry(geom::LbrSolid& solid, const Profile& profile, const motion::
   seq_.resize(ring.capacity());
   chan_.resize(ring.capacity());
   weight_.resize(ring.capacity());
+  prefix_units_.resize(batch_capacity(ring.capacity()));
   const std::size_t cells = static_cast<std::size_t>(solid.levels()) * static_cast<std::size_t>(solid.regions());
   if (cells <= (std::size_t{1} << 22)) stamp_.assign(cells, 0);  // else: cells counted per sweep
 }
@@ -116,13 +117,57 @@ bool Geometry::stop_due() noexcept {
   return now - t >= stop_grace_ns_;
 }
 
-void Geometry::kernel(std::span<const geom::SweepRef> part) noexcept {
+void Geometry::kernel(std::span<const geom::SweepRef> part, const Part& info) noexcept {
   const std::int64_t t_start = sched::now_ns();
-  solid_.subtract(part);
-  work_.record(sched::now_ns() - t_start);
+  const geom::SubtractStats st = solid_.subtract(part);
+  const std::int64_t took = sched::now_ns() - t_start;
+  work_.record(took);
+  if (timed_) sizer_.observe(info.units, took);
   calls_.store(calls_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   sweeps_.store(sweeps_.load(std::memory_order_relaxed) + part.size(), std::memory_order_relaxed);
+  if (log_n_ < log_.size()) {
+    KernelCallRecord& r = log_[log_n_];
+    r.t_ns = t_start - log_t0_ns_;
+    r.dur_us = static_cast<std::uint32_t>(took / 1000);
+    r.sweeps = static_cast<std::uint32_t>(part.size());
+    r.units = static_cast<float>(info.units);
+    r.predicted_us = static_cast<float>(sizer_.predict_ns(info.units) * 1e-3);
+    r.cells_clipped = static_cast<std::uint32_t>(st.cells_clipped);
+    r.sections = static_cast<std::uint32_t>(st.sections);
+    r.cell_vertices = static_cast<std::uint32_t>(info.cell_vertices);
+    r.backlog_us = static_cast<std::uint32_t>(std::max<std::int64_t>(0, info.backlog_ns) / 1000);
+  }
   if (kernel_delay_ns_ > 0) sched::sleep_until_ns(sched::now_ns() + kernel_delay_ns_);
+}
+
+void Geometry::set_kernel_log(std::size_t capacity, std::int64_t t0_ns) {
+  log_.assign(capacity, KernelCallRecord{});
+  log_n_ = 0;
+  log_t0_ns_ = t0_ns;
+}
+
+std::int64_t Geometry::backlog_ns(std::int64_t now_ns) const noexcept {
+  return lag_done_ < taken_ ? now_ns - rx_[lag_done_] : 0;
+}
+
+void Geometry::record_lag(std::span<const motion::SweepInfo> info, std::int64_t now_ns) noexcept {
+  for (const motion::SweepInfo& w : info) {
+    if (w.channel < 0 || w.channel >= hal::kMaxChannels) continue;
+    const auto c = static_cast<std::size_t>(w.channel);
+    if (!done_any_[c] || w.last_seq > done_seq_[c]) done_seq_[c] = w.last_seq, done_any_[c] = true;
+  }
+  // In ring order: an entry of another channel not applied yet holds the later ones back
+  // (their lag is recorded later, never earlier than true).
+  std::uint32_t n = 0;
+  while (lag_done_ < taken_) {
+    const std::uint8_t c = chan_[lag_done_];
+    if (c >= hal::kMaxChannels || !done_any_[c] || seq_[lag_done_] > done_seq_[c]) break;
+    for (std::uint32_t w = 0; w < weight_[lag_done_]; ++w) lag_.record(now_ns - rx_[lag_done_]);
+    ++lag_done_;
+    ++n;
+  }
+  call_samples_ = n;
+  if (log_n_ < log_.size()) log_[log_n_++].samples = n;
 }
 
 void Geometry::set_checks(LiveChecks* checks) noexcept {
@@ -140,7 +185,7 @@ std::size_t Geometry::checked(std::size_t i, std::size_t j) noexcept {
   return end;
 }
 
-bool Geometry::apply_pieces(const geom::SweepRef& s, int k) noexcept {
+bool Geometry::apply_pieces(const geom::SweepRef& s, int k, const Part& info) noexcept {
   // Pieces at geom::Sweep's own interpolated poses.
   split_.store(split_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   geom::SweepRef piece = s;
@@ -157,60 +202,96 @@ bool Geometry::apply_pieces(const geom::SweepRef& s, int k) noexcept {
       const double n = geom::norm(a);
       piece.to.axis = n > 0.0 ? (1.0 / n) * a : s.from.axis;
     }
-    kernel(std::span<const geom::SweepRef>(&piece, 1));
+    Part one = info;
+    one.units = info.units / k;
+    kernel(std::span<const geom::SweepRef>(&piece, 1), one);
+    if (p < k && log_n_ < log_.size()) log_[log_n_++].samples = 0;
   }
   return true;
 }
 
+double Geometry::added_units(const geom::SweepRef& s, Part& part) noexcept {
+  Reach r;
+  part.sections = 0.0;
+  if (!reach(s, r)) return 1.0;
+  const double levels = r.l1 - r.l0 + 1;
+  double cells = 0.0;
+  if (stamp_.empty()) {
+    cells = levels * (r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1);
+  } else {
+    const auto regions_x = static_cast<std::size_t>(solid_.regions_x());
+    const auto nl = static_cast<std::size_t>(solid_.levels());
+    const bool logging = log_n_ < log_.size();
+    for (int y = r.y0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x) {
+        const std::size_t region = static_cast<std::size_t>(y) * regions_x + static_cast<std::size_t>(x);
+        for (int l = r.l0; l <= r.l1; ++l) {
+          std::uint32_t& st = stamp_[region * nl + static_cast<std::size_t>(l)];
+          if (st == stamp_gen_) continue;
+          st = stamp_gen_, cells += 1.0;
+          if (!logging) continue;
+          for (const geom::Polygon& poly : solid_.cell(static_cast<int>(region), l).polys) {
+            part.cell_vertices += static_cast<double>(poly.outer.pts.size());
+            for (const geom::Contour& h : poly.holes) part.cell_vertices += static_cast<double>(h.pts.size());
+          }
+        }
+      }
+  }
+  part.sections = kSectionUnits * levels * r.tilt;
+  return part.sections + kCellUnits * cells;
+}
+
+std::size_t Geometry::sub_batch(std::span<const geom::SweepRef> batch, std::size_t i, Part& part) noexcept {
+  if (++stamp_gen_ == 0) {
+    std::fill(stamp_.begin(), stamp_.end(), 0U);
+    stamp_gen_ = 1;
+  }
+  double budget = budget_;
+  if (timed_) {
+    const std::int64_t now = sched::now_ns();
+    part.backlog_ns = backlog_ns(now);
+    part.target_ns = sizer_.target_ns(part.backlog_ns);
+    budget = sizer_.budget_units(part.target_ns);
+  }
+  std::size_t j = i;
+  for (; j < batch.size(); ++j) {
+    Part probe = part;
+    const double u = added_units(batch[j], probe);
+    if (j > i && part.units + u > budget) break;
+    part = probe;
+    part.units += u;
+    if (j == i) part.first = u, part.first_sections = probe.sections;
+    if (j - i < prefix_units_.size()) prefix_units_[j - i] = part.units;
+  }
+  return j;
+}
+
 bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
-  if (checks_ != nullptr) checks_->begin(batch, stream_.batch_info());
+  const std::span<const motion::SweepInfo> info = stream_.batch_info();
+  if (checks_ != nullptr) checks_->begin(batch, info);
   std::size_t i = 0;
   while (i < batch.size()) {
     if (stop_due()) return false;
-    // The longest prefix within the budget: sections per sweep, cells once per sub-batch.
-    if (++stamp_gen_ == 0) {
-      std::fill(stamp_.begin(), stamp_.end(), 0U);
-      stamp_gen_ = 1;
-    }
-    double units = 0.0, first = 0.0;
-    std::size_t j = i;
-    for (; j < batch.size(); ++j) {
-      Reach r;
-      double u = 1.0;
-      if (reach(batch[j], r)) {
-        const double levels = r.l1 - r.l0 + 1;
-        double cells = 0.0;
-        if (stamp_.empty()) {
-          cells = levels * (r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1);
-        } else {
-          const auto regions_x = static_cast<std::size_t>(solid_.regions_x());
-          const auto nl = static_cast<std::size_t>(solid_.levels());
-          for (int y = r.y0; y <= r.y1; ++y)
-            for (int x = r.x0; x <= r.x1; ++x) {
-              const std::size_t base = (static_cast<std::size_t>(y) * regions_x + static_cast<std::size_t>(x)) * nl;
-              for (int l = r.l0; l <= r.l1; ++l) {
-                std::uint32_t& st = stamp_[base + static_cast<std::size_t>(l)];
-                if (st != stamp_gen_) st = stamp_gen_, cells += 1.0;
-              }
-            }
-        }
-        u = kSectionUnits * levels * r.tilt + kCellUnits * cells;
-      }
-      if (j > i && units + u > budget_) break;
-      units += u;
-      if (j == i) first = u;
-    }
+    Part part;
+    std::size_t j = sub_batch(batch, i, part);
     // The checks judge the sub-batch against the stock now; a sweep after the first that
     // meets material ends it (judged again, as the first of the next, once the ones before
     // it are subtracted).
     j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
     j = checked(i, j);
-    if (j == i + 1 && first > budget_) {
-      // One sweep over the budget: cut into pieces.
-      if (!apply_pieces(batch[i], std::min(kMaxPieces, static_cast<int>(std::ceil(first / budget_))))) return false;
+    if (j - i - 1 < prefix_units_.size()) part.units = prefix_units_[j - i - 1];  // the sweeps it keeps
+    // Timed calls cut a sweep only for its sections (a turning tool axis): every piece
+    // clips the same cells, so cutting a sweep whose cost is its cells multiplies it.
+    const int k = j > i + 1 ? 1
+                  : timed_  ? sizer_.pieces(part.first_sections, part.target_ns, kMaxPieces)
+                  : part.first > budget_ ? std::min(kMaxPieces, static_cast<int>(std::ceil(part.first / budget_)))
+                                         : 1;
+    if (k > 1) {  // one sweep over the budget: cut into pieces
+      if (!apply_pieces(batch[i], k, part)) return false;
     } else {
-      kernel(batch.subspan(i, j - i));
+      kernel(batch.subspan(i, j - i), part);
     }
+    if (info.size() == batch.size()) record_lag(info.subspan(i, j - i), sched::now_ns());
     i = j;
   }
   return true;
@@ -221,6 +302,8 @@ std::size_t Geometry::tick(std::size_t limit) {
   abandoned_ = false;
   std::size_t n = 0;
   taken_ = 0;
+  lag_done_ = 0;
+  done_any_ = {};
   limit = std::min(limit, rx_.size());
   while (n < limit) {
     hal::AxisSample* s = ring_.front();
@@ -251,8 +334,9 @@ std::size_t Geometry::tick(std::size_t limit) {
     last_ = pending_;
     have_ = pending_have_;
     const std::int64_t t = sched::now_ns();
-    for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t i = lag_done_; i < n; ++i)  // what no kernel call completed (poses, rests)
       for (std::uint32_t w = 0; w < weight_[i]; ++w) lag_.record(t - rx_[i]);
+    lag_done_ = n;
     applied_.store(applied_.load(std::memory_order_relaxed) + samples, std::memory_order_relaxed);
     coalesced_.store(coalesced_.load(std::memory_order_relaxed) + samples - n, std::memory_order_relaxed);
     if (++ticks_since_volume_ >= 50) publish_volume();

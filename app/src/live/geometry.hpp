@@ -3,13 +3,19 @@
 // of straight runs per channel), subtract them, record lag and batch work, publish to the
 // render side.
 //
-// Bounded work (issue 13 item 4b): the batch is subtracted in sub-batches whose estimated
+// Bounded work (issue 13 item 4): the batch is subtracted in sub-batches whose estimated
 // work (work_units(): the (level, region) cells the sweeps reach and the sections they
 // need, a tool-axis turn counting as many sections) stays within a budget, and a single
 // sweep over the budget is cut into pieces at poses interpolated as geom::Sweep does (tip
-// linear, axis normalised-linear). The split depends only on the sweeps, so a non-live
-// run stays reproducible. Between kernel calls the geometry thread looks at the stop
-// request: once stop_grace_ns has passed since it was made, the rest is abandoned.
+// linear, axis normalised-linear). Live sources size the sub-batches by time instead
+// (live/call_sizer.hpp: a target call time from the backlog, units converted to time by a
+// rate fitted online); replay and emulator runs as fast as possible keep the fixed budget,
+// so their split depends only on the sweeps and such a run stays reproducible. Between
+// kernel calls the geometry thread looks at the stop request: once stop_grace_ns has passed
+// since it was made, the rest is abandoned.
+//
+// Lag: a sample's lag is recorded when the kernel call that applies its sweep returns (the
+// sweep whose last sample it is or follows, per channel), not at the end of the tick.
 //
 // Real-time contract (tests/app_live_alloc_test.cpp measures it): draining the ring and the
 // motion stream never allocate; LbrSolid::subtract() allocates inside Clipper (bounded by
@@ -18,13 +24,16 @@
 // allocation failure terminates (std::bad_alloc is not caught on this thread).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <span>
 #include <vector>
 
+#include "app/live.hpp"
 #include "app/profile.hpp"
+#include "live/call_sizer.hpp"
 #include "geom/lbr_solid.hpp"
 #include "live/checks.hpp"
 #include "gfx/exchange.hpp"
@@ -67,6 +76,18 @@ class Geometry final : public motion::SweepSink {
   std::uint64_t discard() noexcept;
   // Work budget of one kernel call [units of work_units()].
   void set_work_budget(double units) noexcept { budget_ = units; }
+  // Live sources: sub-batches sized by time (live/call_sizer.hpp) instead of the fixed
+  // budget. Setup.
+  void set_timed_calls(bool on, const CallSizerConfig& c = {}) noexcept {
+    timed_ = on;
+    sizer_ = CallSizer(c);
+  }
+  [[nodiscard]] const CallSizer& sizer() const noexcept { return sizer_; }
+  // Diagnostics: record up to `capacity` kernel calls (allocates now; setup).
+  void set_kernel_log(std::size_t capacity, std::int64_t t0_ns);
+  [[nodiscard]] std::span<const KernelCallRecord> kernel_log() const noexcept {
+    return {log_.data(), std::min(log_n_, log_.size())};
+  }
   [[nodiscard]] double work_budget() const noexcept { return budget_; }
   // Testing: sleep this long after every kernel call (a deliberately slowed kernel).
   void set_kernel_delay_ns(std::int64_t ns) noexcept { kernel_delay_ns_ = ns; }
@@ -126,11 +147,30 @@ class Geometry final : public motion::SweepSink {
   static std::array<kin::Kinematics, motion::kMaxChannels> channel_kinematics(const Profile& profile);
   // Subtracts `batch` in sub-batches within the work budget; false when a stop cut it short.
   bool apply(std::span<const geom::SweepRef> batch) noexcept;
-  void kernel(std::span<const geom::SweepRef> part) noexcept;
+  // What apply() knows of one sub-batch before its kernel call.
+  struct Part {
+    double units = 0.0;          // work estimate, cells once
+    double first = 0.0;          // of its first sweep alone
+    double first_sections = 0.0; // of its first sweep's sections (what pieces share out)
+    double sections = 0.0;       // added_units(): of the last sweep's sections
+    double cell_vertices = 0.0;  // only with a kernel log
+    std::int64_t target_ns = 0;  // the call time it was sized for (timed calls)
+    std::int64_t backlog_ns = 0;
+  };
+  // The end of the longest prefix of batch[i..] within the budget (at least i + 1).
+  std::size_t sub_batch(std::span<const geom::SweepRef> batch, std::size_t i, Part& part) noexcept;
+  // Work units sweep s adds to the current sub-batch (its sections, its cells not yet
+  // counted); its vertices go to part.cell_vertices when logging.
+  double added_units(const geom::SweepRef& s, Part& part) noexcept;
+  void kernel(std::span<const geom::SweepRef> part, const Part& info) noexcept;
+  // After batch[i, j) was applied: records the lag of the ring entries it completed.
+  void record_lag(std::span<const motion::SweepInfo> info, std::int64_t now_ns) noexcept;
+  // Age of the oldest ring entry of this tick not applied yet [ns] (0: none).
+  [[nodiscard]] std::int64_t backlog_ns(std::int64_t now_ns) const noexcept;
   // The end of the prefix of [i, j) the kernel may subtract now (the checks' verdict).
   std::size_t checked(std::size_t i, std::size_t j) noexcept;
   // Subtracts the single sweep s in k pieces; false when a stop cut it short.
-  bool apply_pieces(const geom::SweepRef& s, int k) noexcept;
+  bool apply_pieces(const geom::SweepRef& s, int k, const Part& info) noexcept;
   // Cells of one sweep [levels l0..l1] x [regions x0..x1, y0..y1]; false when it reaches none.
   struct Reach {
     int l0 = 0, l1 = -1, x0 = 0, x1 = -1, y0 = 0, y1 = -1;
@@ -150,6 +190,16 @@ class Geometry final : public motion::SweepSink {
   std::vector<std::uint32_t> stamp_;       // per (region, level): sub-batch that counted it
   std::uint32_t stamp_gen_ = 0;
   double budget_ = 60'000.0;
+  bool timed_ = false;
+  CallSizer sizer_;
+  std::vector<double> prefix_units_;  // sub_batch(): units of its first k + 1 sweeps
+  std::size_t lag_done_ = 0;  // ring entries of this tick whose lag is recorded
+  std::array<std::uint64_t, hal::kMaxChannels> done_seq_{};  // per channel: applied up to this sample
+  std::array<bool, hal::kMaxChannels> done_any_{};
+  std::uint32_t call_samples_ = 0;  // ring entries the current kernel call completed
+  std::vector<KernelCallRecord> log_;
+  std::size_t log_n_ = 0;
+  std::int64_t log_t0_ns_ = 0;
   std::int64_t kernel_delay_ns_ = 0;
   const std::atomic<bool>* stop_a_ = nullptr;
   const std::atomic<bool>* stop_b_ = nullptr;

@@ -164,17 +164,36 @@ gfx::LiveStats live_stats(const LivePipeline::Impl& p) {
 // that are not live (replay/emulator as fast as possible) are applied in chunks of exactly
 // lbr.batch_moves samples, so such a run is reproducible bit for bit.
 //
-// Duty limit: after a tick that worked w, a live source's geometry thread rests
-// w·(1/duty − 1) before the next (samples queue meanwhile and merge into longer sweeps).
-// A SCHED_FIFO thread that keeps a core busy trips the kernel's real-time throttling
-// (sched_rt_runtime_us, by default 950 ms per second), which then stops it for the rest of
-// the second: measured 50–56 ms stalls and a lag p99 of 31 ms on the "high" workload at
-// 1 kHz without this limit.
+// Duty limit: a live source's geometry thread earns `duty` seconds of work per second of
+// wall time, banked up to kDutyBurstNs, and spends its work on it; when the bank is
+// overdrawn it rests until it is even (samples queue meanwhile and merge into longer
+// sweeps). A SCHED_FIFO thread that keeps a core busy trips the kernel's real-time
+// throttling (sched_rt_runtime_us, by default 950 ms per second), which then stops it for
+// the rest of the second: measured 50–56 ms stalls and a lag p99 of 31 ms on the "high"
+// workload at 1 kHz without a limit. The bank bounds the work of any second by
+// kDutyBurstNs + duty·1 s (0.9 s at the default 0.7), and a single long tick no longer
+// forces a rest (before: w·(1/duty − 1) after every tick, which added up to 43 % of each
+// long call to the lag of the samples queued behind it).
 //
 // Stop (docs/architecture.md "Live overload"): after a stop request the thread goes on
 // applying what is queued for kStopGraceNs, then abandons the rest (counted as
 // samples_unapplied) — checked between kernel calls, whose work the budget bounds.
 constexpr std::int64_t kStopGraceNs = 250'000'000;
+constexpr std::int64_t kDutyBurstNs = 200'000'000;
+
+// Gathering (live sources): a kernel call pays a fixed cost for every cell it clips, so a
+// thread that applies each sample as soon as it arrives spends most of its time re-clipping
+// the same cells (measured: busy 63–69 % of the time at 1 kHz on finish3d, calls of one
+// sweep, and held at the duty limit, where the rests build a backlog). It waits instead
+// until the oldest queued sample is kGatherFactor × the recent tick time old (the EWMA of
+// the work per tick), at most kGatherMaxNs: work per tick c, gathered for 4c, keeps the
+// thread at most a quarter busy where it can, and a sample's lag stays within the gather
+// time plus one tick. Measured on helix (16x16 cells, 1 kHz): gathering 2c (≈ 1 ms) made
+// 97 k kernel calls busy for 70 s and lag p99 19.7 ms; gathering 2.5 ms, 59 k calls, 53 s,
+// p99 13.0 ms (docs/performance.md "Live lag").
+constexpr double kGatherFactor = 4.0;
+constexpr std::int64_t kGatherMaxNs = 2'500'000;
+constexpr double kTickEwmaWeight = 0.1;
 
 void bump(std::atomic<std::uint64_t>& c) noexcept { c.store(c.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
 
@@ -230,27 +249,48 @@ void offer_snapshot(LivePipeline::Impl& p, std::int64_t& due_ns) {
   due_ns = sched::now_ns() + p.snapshot_period_ns;
 }
 
+// Waits (see kGatherFactor) while the oldest queued sample is young; returns at once when
+// the ring is empty (the caller's idle wait) or a stop is asked for.
+bool stop_asked(const LivePipeline::Impl& p) noexcept;
+
+void gather(LivePipeline::Impl& p, double tick_ewma_ns) noexcept {
+  const hal::AxisSample* s = p.ring->front();
+  if (s == nullptr) return;
+  const auto wait_ns = static_cast<std::int64_t>(std::min(static_cast<double>(kGatherMaxNs), kGatherFactor * tick_ewma_ns));
+  const std::int64_t due = s->t_rx_ns + wait_ns;
+  if (due > sched::now_ns() && !stop_asked(p)) sched::sleep_until_ns(due);
+}
+
 void geometry_thread(LivePipeline::Impl& p) {
   const hal::LiveConfig& cfg = p.profile.live;
   p.geo_mode = sched::configure_current_thread(cfg.geometry_thread) == sched::RtMode::Fifo ? 1 : 0;
   const std::size_t chunk = p.backpressure ? static_cast<std::size_t>(p.profile.batch_moves) : p.ring->capacity();
   const std::int64_t idle_ns = static_cast<std::int64_t>(cfg.geometry_idle_us) * 1000;
-  const double rest_per_work = p.backpressure ? 0.0 : 1.0 / cfg.geometry_duty - 1.0;
+  const bool duty_limited = !p.backpressure && cfg.geometry_duty < 1.0;
+  double credit_ns = static_cast<double>(kDutyBurstNs);
+  std::int64_t t_credit = sched::now_ns();
+  double tick_ewma_ns = 0.0;
   std::int64_t snapshot_due_ns = sched::now_ns() + p.snapshot_period_ns;
   p.progress->geometry_running.store(true, std::memory_order_relaxed);
   for (;;) {
     bump(p.progress->geometry_loops);
     mark_recording(p, sched::now_ns());
     const bool finished = p.hal_done.load(std::memory_order_acquire);
-    const std::int64_t t_tick = sched::now_ns();
+    if (!p.backpressure && !finished) gather(p, tick_ewma_ns);
+    const std::int64_t t_tick = sched::now_ns();  // the tick's work starts here (not its gathering)
     if (p.geo->stop_due()) break;
     if ((finished || !p.backpressure || p.ring->size() >= chunk) && p.geo->tick(chunk) > 0) {
+      tick_ewma_ns += kTickEwmaWeight * (static_cast<double>(sched::now_ns() - t_tick) - tick_ewma_ns);
       if (p.geo->abandoned()) break;
       if (p.opt.exchange != nullptr) (void)p.geo->publish(live_stats(p));
       offer_snapshot(p, snapshot_due_ns);
-      if (rest_per_work > 0.0 && !finished) {
+      if (duty_limited && !finished) {
         const std::int64_t now = sched::now_ns();
-        sched::sleep_until_ns(now + static_cast<std::int64_t>(static_cast<double>(now - t_tick) * rest_per_work));
+        credit_ns = std::min(static_cast<double>(kDutyBurstNs),
+                             credit_ns + cfg.geometry_duty * static_cast<double>(now - t_credit)) -
+                    static_cast<double>(now - t_tick);
+        t_credit = now;
+        if (credit_ns < 0.0) sched::sleep_until_ns(now + static_cast<std::int64_t>(-credit_ns / cfg.geometry_duty));
       }
       continue;
     }
@@ -429,7 +469,12 @@ void configure_program(LivePipeline::Impl& p) {
 
 geom::SolidSpec live_solid_spec(const Profile& profile, const motion::ToolTable& tools) {
   geom::SolidSpec spec = profile.solid;
-  if (profile.regions_auto) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tools.max_diameter());
+  bool automatic = profile.regions_auto;
+  if (profile.live_grid.set) {  // [lbr] live_regions
+    automatic = profile.live_grid.automatic;
+    if (!automatic) spec.regions_x = profile.live_grid.x, spec.regions_y = profile.live_grid.y;
+  }
+  if (automatic) std::tie(spec.regions_x, spec.regions_y) = auto_region_grid(spec, tools.max_diameter());
   return spec;
 }
 
@@ -529,6 +574,10 @@ void LivePipeline::configure() {
   p.src = live::make_source(profile, p.opt.source, p.opt.speed, emulator ? position : 0, &p.emulator);
   p.src->open();
   p.backpressure = !p.src->live();
+  // Live sources: sub-batches sized by time (live/call_sizer.hpp); as fast as possible:
+  // the fixed budget, reproducible.
+  p.geo->set_timed_calls(!p.backpressure && p.opt.test_work_budget <= 0);
+  if (p.opt.kernel_log_capacity > 0) p.geo->set_kernel_log(p.opt.kernel_log_capacity, sched::now_ns());
   if (p.rec_file != nullptr) {
     p.rec_ring = std::make_unique<sched::SpscRing<hal::RawRecord>>(1 << 15);
     p.src->set_recording(true);
@@ -656,6 +705,7 @@ LiveResult LivePipeline::result() {
     r.decode_errors[hal::fault_name(f)] = p.src->counters().get(f) + p.sink->counters().get(f);
   }
   fill_check_results(p, r);
+  r.kernel_log.assign(p.geo->kernel_log().begin(), p.geo->kernel_log().end());
   const bool fifo = p.hal_mode.load() == 1 && p.geo_mode.load() == 1;
   r.rt_mode = fifo ? "fifo" : "non-rt";
   if (p.snap) {  // clean shutdown: the final state, after any periodic one still being written
