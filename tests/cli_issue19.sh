@@ -4,11 +4,11 @@
 # Each case asserts quantities (files and their content, exit codes, pixel counts, warning
 # text within a time bound), not whole outputs.
 set -uo pipefail
+. "$(dirname "$0")/cli_lib.sh"
 CASE=$1 B=$2 SRC=$3 OUT=$4
 LBRSIM=$B/app/lbrsim PROBE=$B/tests/png_probe
 rm -rf "$OUT" && mkdir -p "$OUT" && cd "$OUT" || exit 1
 fail() { echo "FAIL [$CASE]: $*" >&2; exit 1; }
-json_num() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }  # key from metrics.json
 results_ok() {  # DIR: metrics.json with applied samples and removed volume, a non-trivial levels file
   [ -s "$1/metrics.json" ] || fail "$1/metrics.json missing"
   [ "$(stat -c %s "$1/levels.lbrs" 2>/dev/null || echo 0)" -gt 1000 ] || fail "$1/levels.lbrs missing or empty"

@@ -6,11 +6,11 @@
 # alarm band, metrics.json and events.csv hold the shank event at the program line of the
 # first move down (line 3) with its sample number. The same program with G43: no event, no band.
 set -uo pipefail
+. "$(dirname "$0")/cli_lib.sh"
 B=$1 OUT=$2
 LBRSIM=$B/app/lbrsim PROBE=$B/tests/png_probe
 rm -rf "$OUT" && mkdir -p "$OUT" && cd "$OUT" || exit 1
 fail() { echo "FAIL: $*" >&2; exit 1; }
-json_num() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }
 body='G0 X20 Y20 Z5\nG1 Z-3 F1000\nG1 X80 F3000\nG1 Y60\nG0 Z20\nM2\n'
 printf "G21 G90 G17\nT1 M6\n$body" >bad.ngc
 printf "G21 G90 G17\nT1 M6 G43 H1\n$body" >good.ngc

@@ -18,6 +18,7 @@
 # replay line); /tmp/lbr-pty becomes OUT_DIR/lbr-pty; lbr-genbench writes to a temporary
 # folder, not bench/programs; rs274 lines are skipped without LinuxCNC's rs274 on PATH.
 set -uo pipefail
+. "$(dirname "$0")/cli_lib.sh"
 B=$(cd "$1" && pwd) SRC=$(cd "$2" && pwd) OUT=$3
 rm -rf "$OUT" && mkdir -p "$OUT/logs" "$OUT/work" && cd "$OUT/work" || exit 1
 ln -s "$SRC/config" config && ln -s "$SRC/bench" bench && ln -s "$SRC/tools" tools && ln -s "$B" build || exit 1
@@ -27,7 +28,6 @@ FAILS=0 N_RUN=0 N_ADAPTED=0 N_SKIPPED=0 N_LOG=0
 LINE='' RC=0 LOG=''  # the line, its exit status and its output (OUT_DIR/logs/N.log)
 
 fail() { echo "FAIL: $LINE"$'\n'"  $*" >&2; FAILS=$((FAILS + 1)); return 1; }
-json_num() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }
 # Run a command line through bash in OUT_DIR/work (the README lines hold redirections, e.g. '>').
 sh_line() {  # [timeout SECS] LINE
   local pre=()

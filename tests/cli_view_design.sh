@@ -7,11 +7,11 @@
 # screenshot shows the slot's faces red; with --color plain none. Levels 0.5 mm apart keep
 # the mesh small for llvmpipe.
 set -uo pipefail
+. "$(dirname "$0")/cli_lib.sh"
 B=$1 OUT=$2
 LBRSIM=$B/app/lbrsim PROBE=$B/tests/png_probe
 rm -rf "$OUT" && mkdir -p "$OUT" && cd "$OUT" || exit 1
 fail() { echo "FAIL: $*" >&2; exit 1; }
-json_num() { sed -n "s/^ *\"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1" | head -1; }
 # The default stock X0..100 Y0..80 Z-30..0, 12 outward triangles.
 v() { case $1 in 0) echo "0 0 -30" ;; 1) echo "100 0 -30" ;; 2) echo "0 80 -30" ;; 3) echo "100 80 -30" ;;
                  4) echo "0 0 0" ;; 5) echo "100 0 0" ;; 6) echo "0 80 0" ;; 7) echo "100 80 0" ;; esac; }

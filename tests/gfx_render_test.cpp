@@ -71,6 +71,16 @@ gfx::RenderOptions test_options() {
   return o;
 }
 
+// A render thread at 30 Hz with the test options, drawing w x h.
+gfx::RenderThreadConfig thread_config(int w, int h) {
+  gfx::RenderThreadConfig cfg;
+  cfg.rate_hz = 30;
+  cfg.render = test_options();
+  cfg.width = w;
+  cfg.height = h;
+  return cfg;
+}
+
 gfx::Camera top_camera(const gfx::Renderer& ren) {
   gfx::Camera cam;
   cam.set_view(gfx::StandardView::Top);
@@ -231,11 +241,7 @@ TEST_F(GfxRender, RenderThreadRunsAtItsRateWhileCutsArrive) {
   geom::LbrSolid s = stock();
   s.clear_dirty();
   gfx::SolidExchange ex;
-  gfx::RenderThreadConfig cfg;
-  cfg.rate_hz = 30;
-  cfg.render = test_options();
-  cfg.width = 320;
-  cfg.height = 240;
+  gfx::RenderThreadConfig cfg = thread_config(320, 240);
   cfg.max_frames = 45;
   gfx::RenderThread rt(*win_, ex, s, cfg);
   rt.start();
@@ -274,11 +280,7 @@ TEST_F(GfxRender, StopWritesAFinalScreenshotOfTheLastPublishedState) {
   geom::LbrSolid s = stock();
   s.clear_dirty();
   gfx::SolidExchange ex;
-  gfx::RenderThreadConfig cfg;
-  cfg.rate_hz = 30;
-  cfg.render = test_options();
-  cfg.width = 160;
-  cfg.height = 120;
+  gfx::RenderThreadConfig cfg = thread_config(160, 120);
   cfg.screenshot_every = 1000000;  // frame 0 only
   const std::string prefix = ::testing::TempDir() + "final-shot-";
   cfg.screenshot_prefix = prefix;

@@ -118,6 +118,15 @@ Image RenderThread::capture(double timeout_s) {
   return got ? std::move(capture_) : Image{};
 }
 
+// The geometry thread's latest snapshot, if a new one was published, then sync().
+void RenderThread::receive_and_sync(Renderer& ren, Snapshot& snap, Camera& cam, int& w, int& h) {
+  if (ex_.take(snap)) {
+    ren.receive(snap);
+    ++report_.snapshots;
+  }
+  sync(ren, cam, w, h);
+}
+
 // Takes the main thread's camera, options, size and UI events for this frame.
 void RenderThread::sync(Renderer& ren, Camera& cam, int& w, int& h) {
   std::lock_guard lock(mu_);
@@ -213,13 +222,9 @@ FrameInfo RenderThread::draw(Renderer& ren, const Camera& cam, int w, int h, dou
 // so that the last file shows the end of the run however many frames a slow machine drew.
 void RenderThread::final_shot(Renderer& ren, Snapshot& snap) {
   if (cfg_.screenshot_every <= 0) return;
-  if (ex_.take(snap)) {
-    ren.receive(snap);
-    ++report_.snapshots;
-  }
   Camera cam;
   int w = 0, h = 0;
-  sync(ren, cam, w, h);
+  receive_and_sync(ren, snap, cam, w, h);
   (void)draw(ren, cam, w, h, 1.0 / cfg_.rate_hz, true);
   ++report_.frames;
 }
@@ -303,13 +308,9 @@ void RenderThread::loop() {
         if (report_.frames % 15 == 0) pacing.p99_period_ms = PacingReport::percentile(window_periods, 0.99);
       }
       prev = t0;
-      if (ex_.take(snap)) {
-        ren.receive(snap);
-        ++report_.snapshots;
-      }
       Camera cam;
       int w = 0, h = 0;
-      sync(ren, cam, w, h);
+      receive_and_sync(ren, snap, cam, w, h);
       ren.set_pacing(pacing);
       const FrameInfo fi = draw(ren, cam, w, h, dt_s);
       const double work = std::chrono::duration<double, std::milli>(clock::now() - t0).count();

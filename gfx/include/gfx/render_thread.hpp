@@ -114,6 +114,7 @@ class RenderThread {
   void loop();
   // Steps of one frame of loop().
   void sync(Renderer& ren, Camera& cam, int& w, int& h);
+  void receive_and_sync(Renderer& ren, Snapshot& snap, Camera& cam, int& w, int& h);
   void apply_ui(const detail::UiActions& act);
   FrameInfo draw(Renderer& ren, const Camera& cam, int w, int h, double dt_s, bool force_shot = false);
   void final_shot(Renderer& ren, Snapshot& snap);
