@@ -219,3 +219,75 @@ TEST(ViewAnimate, JumpsToATimeOrALineRemoveWhatTheSweepsUpToThereRemove) {
   drain.store(false);
   render.join();
 }
+
+namespace {
+
+// Streams `program` (G-code text) on the default profile at 500x; the streamer's events and
+// the alarms of the last snapshot the "render side" took.
+struct CheckedStream {
+  std::vector<verify::Event> events;
+  gfx::LiveStats last;
+};
+
+CheckedStream stream_checked(const std::string& program) {
+  const std::string file = ::testing::TempDir() + "view_checks.ngc";
+  {
+    std::FILE* f = std::fopen(file.c_str(), "w");
+    std::fputs(program.c_str(), f);
+    std::fclose(f);
+  }
+  const app::Profile profile = app::load_profile(kConfig + "profiles/default-mill3.toml");
+  const std::vector<app::ChannelPath> channels{{"", app::load_toolpath(file, profile), profile.kin}};
+  geom::LbrSolid solid(app::stream_solid_spec(profile, channels));
+  solid.clear_dirty();
+  gfx::SolidExchange ex(1 << 14);
+  app::PathStreamer streamer(profile, channels, solid, ex, app::StreamOptions{500.0, 0.004, 0.002});
+  streamer.start();
+  CheckedStream out;
+  gfx::Snapshot snap;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!streamer.done() && std::chrono::steady_clock::now() < deadline) {
+    if (ex.take(snap)) out.last = snap.stats;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  streamer.stop();
+  if (ex.take(snap)) out.last = snap.stats;
+  out.events = streamer.events();
+  return out;
+}
+
+}  // namespace
+
+// Issue 16 in `view --animate`: a program that forgets G43 H1 drives the 60 mm tool's shank
+// and holder through the stock. The streamer checks each tick's sweeps like batch (the rapid
+// down at line 4 removes material, the shank meets it from line 4, the holder from line 5),
+// and the newest events are the status bar's alarms. With G43 H1 nothing is raised.
+TEST(ViewAnimate, AForgottenG43RaisesEventsAtTheirLinesAndShowsThemAsAlarms) {
+  const std::string body = "T1 M6\nS8000 M3\nG0 X20 Y20 Z5\nG1 Z-2 F300\nG1 X60 F600\nG0 Z5\nM2\n";
+  const CheckedStream bad = stream_checked("G21 G90 G17\n" + body);
+  auto first_line = [&](verify::EventKind k) {
+    for (const verify::Event& e : bad.events)
+      if (e.kind == k) return e.line;
+    return -1;
+  };
+  EXPECT_EQ(first_line(verify::EventKind::RapidIntoMaterial), 4);
+  EXPECT_EQ(first_line(verify::EventKind::ShankInMaterial), 4);
+  EXPECT_EQ(first_line(verify::EventKind::HolderInMaterial), 5);
+  for (const verify::Event& e : bad.events) EXPECT_NE(e.source.find("view_checks.ngc"), std::string::npos) << e.source;
+  // The rapid's tool (flat D10, 60 mm long, tip at Z-55) crosses all 30 mm of the stock:
+  // at least the D10 x 30 mm cylinder of its final position.
+  double rapid_mm3 = 0.0;
+  for (const verify::Event& e : bad.events)
+    if (e.kind == verify::EventKind::RapidIntoMaterial) rapid_mm3 += e.volume_mm3;
+  EXPECT_GT(rapid_mm3, 0.95 * M_PI * 25.0 * 30.0);
+  ASSERT_EQ(bad.last.alarm_count, std::min<int>(static_cast<int>(bad.events.size()), app::kShownEventAlarms) +
+                                      (bad.events.size() > app::kShownEventAlarms ? 1 : 0));
+  EXPECT_EQ(bad.last.alarms[0].severity, gfx::AlarmSeverity::Error);
+  EXPECT_NE(std::string(bad.last.alarms[0].text.data()).find("in-material"), std::string::npos)
+      << bad.last.alarms[0].text.data();
+
+  const CheckedStream good = stream_checked("G21 G90 G17\nT1 M6 G43 H1\nS8000 M3\nG0 X20 Y20 Z5\nG1 Z-2 F300\n"
+                                            "G1 X60 F600\nG0 Z5\nM2\n");
+  EXPECT_TRUE(good.events.empty()) << verify::describe(good.events.front());
+  EXPECT_EQ(good.last.alarm_count, 0);
+}

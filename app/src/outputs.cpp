@@ -1,5 +1,6 @@
 #include "app/outputs.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstdio>
@@ -82,6 +83,29 @@ std::vector<ChannelPath> load_channel_paths(const Profile& profile, Interpreter 
 }
 
 nc::Toolpath demo_toolpath() { return nc::parse_movelist(kDemoProgram, "<built-in demo-pocket.moves>"); }
+
+void fill_event_alarms(std::span<const verify::Event> events, std::uint64_t not_stored, int shown, bool by_sample,
+                       gfx::LiveStats& stats) noexcept {
+  stats.alarm_count = 0;
+  const std::size_t n = events.size();
+  const std::size_t limit = std::min<std::size_t>(static_cast<std::size_t>(std::max(0, shown)), gfx::kMaxAlarms - 1);
+  const std::size_t count = std::min(n, limit);
+  char text[gfx::kAlarmTextChars];
+  char at[32] = "";
+  for (std::size_t i = 0; i < count; ++i) {  // newest first
+    const verify::Event& e = events[n - 1 - i];
+    if (by_sample) std::snprintf(at, sizeof at, " sample %u", e.move);
+    std::snprintf(text, sizeof text, "%s T%d line %d%s: %.1f mm3 at X%.1f Y%.1f Z%.1f", verify::to_string(e.kind),
+                  e.tool, e.line, at, e.volume_mm3, e.position.x, e.position.y, e.position.z);
+    const auto severity = e.severity() == verify::Severity::Error ? gfx::AlarmSeverity::Error : gfx::AlarmSeverity::Warning;
+    gfx::set_alarm(stats.alarms[static_cast<std::size_t>(stats.alarm_count++)], severity, text);
+  }
+  if (n > count || not_stored > 0) {
+    std::snprintf(text, sizeof text, "%llu collision events in all (events.csv when the run ends)",
+                  static_cast<unsigned long long>(n + not_stored));
+    gfx::set_alarm(stats.alarms[static_cast<std::size_t>(stats.alarm_count++)], gfx::AlarmSeverity::Error, text);
+  }
+}
 
 std::string design_summary(const verify::DesignReport& d, double tolerance_mm) {
   char buf[512];

@@ -73,10 +73,56 @@ PathStreamer::PathStreamer(const Profile& profile, const std::vector<ChannelPath
   for (const ChannelPath& c : channels) tools_.require_path(c.path);
   nc::EmulatorLimits limits = emulator_limits(profile);
   limits.sample_period_ms = opt_.sample_period_s * 1e3;
-  motion::PlannedSweeps plan = motion::plan_channels(tools_, channels, limits, !has_tool_axes(channels));
+  const bool sampled = !has_tool_axes(channels);
+  motion::PlannedSweeps plan = motion::plan_channels(tools_, channels, limits, sampled);
   sweeps_ = std::move(plan.sweeps);
   duration_s_ = plan.machining_time_s;
   if (opt_.control != nullptr) initial_ = std::make_unique<geom::LbrSolid>(solid_);
+  if (profile.checks.enabled) setup_checks(profile, channels, sampled);
+}
+
+void PathStreamer::setup_checks(const Profile& profile, const std::vector<ChannelPath>& channels, bool sampled) {
+  for (const ChannelPath& c : channels) sources_.push_back(c.path.source);
+  if (sampled) {
+    // As live mode: faster than the max cutting feed by more than the margin is a rapid.
+    const double fast_mm_per_s = verify::kFastMargin *
+                                 verify::rapid_threshold_mm_per_min(profile.machine.max_feed_mm_per_min,
+                                                                    profile.machine.rapid_mm_per_min) / 60.0;
+    rapid_.assign(sweeps_.size(), 0);
+    std::vector<double> t_prev(channels.size(), 0.0);
+    for (std::size_t i = 0; i < sweeps_.size(); ++i) {
+      const motion::TimedSweep& s = sweeps_[i];
+      double& t0 = t_prev[static_cast<std::size_t>(s.channel)];
+      const geom::Vec3 d = s.ref.to.tip - s.ref.from.tip;
+      const double dt = s.t_s - t0;
+      rapid_[i] = dt > 0.0 && std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z) > fast_mm_per_s * dt ? 1 : 0;
+      t0 = s.t_s;
+    }
+  } else {
+    geom::MoveId base = 0;  // segment ids of each channel, as motion::plan_channels() gives them
+    for (const ChannelPath& c : channels) {
+      index_.add(c.path, base);
+      base += static_cast<geom::MoveId>(c.path.segments.size());
+    }
+  }
+  checker_ = std::make_unique<verify::CollisionChecker>(profile.checks, tools_, index_);
+}
+
+void PathStreamer::subtract_checked(std::size_t from, std::size_t to, std::vector<geom::SweepRef>& batch) {
+  while (from < to) {
+    std::size_t end = to;
+    const std::size_t before = events_.size();
+    if (checker_ && rapid_.empty()) end = checker_->check(solid_, sweeps_, from, to, events_);
+    else if (checker_) end = checker_->check(solid_, sweeps_, rapid_, from, to, events_, true);
+    for (std::size_t k = before; k < events_.size(); ++k) {  // a sampled sweep names its line, not its program
+      verify::Event& e = events_[k];
+      if (e.source.empty() && static_cast<std::size_t>(e.channel) < sources_.size()) e.source = sources_[e.channel];
+    }
+    batch.clear();
+    for (std::size_t k = from; k < end; ++k) batch.push_back(sweeps_[k].ref);
+    solid_.subtract(batch);
+    from = end;
+  }
 }
 
 PathStreamer::~PathStreamer() { stop(); }
@@ -123,6 +169,7 @@ void PathStreamer::restart(std::size_t& next, geom::MoveId& last) {
   next = 0;
   last = 0;
   line_ = -1;
+  events_.clear();
 }
 
 double PathStreamer::take_seek() {
@@ -147,17 +194,16 @@ double PathStreamer::take_seek() {
 
 bool PathStreamer::apply_due(double sim_s, std::size_t& next, geom::MoveId& last, std::vector<geom::SweepRef>& batch) {
   using clock = std::chrono::steady_clock;
-  batch.clear();
+  const std::size_t from = next;
   for (; next < sweeps_.size() && sweeps_[next].t_s <= sim_s; ++next) {
     const motion::TimedSweep& s = sweeps_[next];
-    batch.push_back(s.ref);
     ex_.add_path_point(s.ref.to.tip);
     last = s.ref.id;
     if (s.channel == 0 && s.line > 0) line_ = s.line;
   }
-  if (batch.empty()) return false;
+  if (next == from) return false;
   const auto t0 = clock::now();
-  solid_.subtract(batch);
+  subtract_checked(from, next, batch);
   batch_ms_.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
   batches_.fetch_add(1, std::memory_order_relaxed);
   return true;
@@ -201,6 +247,7 @@ void PathStreamer::loop() {
     stats.program_line = line_;
     stats.machining_s = std::clamp(sim, 0.0, duration_s_);
     stats.paused = opt_.control != nullptr && opt_.control->paused.load(std::memory_order_relaxed);
+    fill_event_alarms(events_, 0, kShownEventAlarms, false, stats);
     const std::span<const gfx::ToolState> shown(tools.data(), tool_count);
     // Publish every tick: a refused publish (render side busy) loses nothing.
     (void)ex_.publish(solid_, shown, last, stats);
@@ -226,7 +273,21 @@ namespace {
 struct ViewDesign {
   std::optional<verify::DesignReport> report;  // a static view's comparison
   std::vector<geom::Paths> sections;            // the model sliced on the stock's levels
+  std::vector<verify::Event> events;            // a static view's checks (the batch run's)
 };
+
+// The checks' summary on stdout ("checks: N errors, M warnings") and the first events, as
+// `lbrsim batch` prints them (no events.csv: batch writes that).
+void print_view_events(const std::vector<verify::Event>& events) {
+  constexpr std::size_t kShown = 5;
+  const verify::EventCounts c = verify::count(events);
+  std::printf("checks: %zu error%s, %zu warning%s\n", c.errors, c.errors == 1 ? "" : "s", c.warnings,
+              c.warnings == 1 ? "" : "s");
+  for (std::size_t k = 0; k < std::min(kShown, events.size()); ++k) {
+    if (events[k].severity() == verify::Severity::Error) spdlog::error("{}", verify::describe(events[k]));
+    else spdlog::warn("{}", verify::describe(events[k]));
+  }
+}
 
 // The batch result with the tool at its final pose and the programmed path (segment ends);
 // with --design, the comparison and the design sections go to `design`.
@@ -235,6 +296,7 @@ std::unique_ptr<geom::LbrSolid> publish_batch_result(const Profile& profile, con
   BatchResult r = channels.size() == 1 ? run_batch(profile, channels.front().path) : run_batch_channels(profile, channels);
   design.report = std::move(r.design);
   design.sections = std::move(r.design_sections);
+  design.events = r.events;
   auto solid = std::make_unique<geom::LbrSolid>(std::move(r.solid));
   solid->clear_dirty();
   std::size_t segments = 0;
@@ -246,7 +308,9 @@ std::unique_ptr<geom::LbrSolid> publish_batch_result(const Profile& profile, con
       if (is_motion(s)) ex.add_path_point({s.end[nc::X], s.end[nc::Y], s.end[nc::Z]});
   }
   const auto tools = channels.size() == 1 ? final_tools(profile, channels.front().path) : std::vector<gfx::ToolState>{};
-  (void)ex.publish(*solid, tools, static_cast<geom::MoveId>(segments), gfx::LiveStats{});
+  gfx::LiveStats stats;
+  fill_event_alarms(r.events, 0, kShownEventAlarms, false, stats);
+  (void)ex.publish(*solid, tools, static_cast<geom::MoveId>(segments), stats);
   return solid;
 }
 
@@ -320,6 +384,7 @@ int run_view(const Profile& profile, const std::vector<ChannelPath>& channels, c
   }, opt.kiosk);
   if (streamer) streamer->stop();
   rt.stop();
+  if (profile.checks.enabled) print_view_events(streamer ? streamer->events() : design.events);
   const gfx::PacingReport& rep = rt.report();
   if (!rep.error.empty()) throw std::runtime_error("render thread: " + rep.error);
   double rebuilt = 0;

@@ -145,6 +145,8 @@ Event CollisionChecker::event_of(const motion::TimedSweep& m, const Finding& f) 
   if (const nc::Segment* seg = index_.find(m.ref.id, &source)) {
     e.line = seg->line;
     e.source = *source;
+  } else {
+    e.line = m.line;  // a sampled stream's sweep knows its line (0: none, e.g. live)
   }
   e.move = m.ref.id;
   e.tool = m.tool;

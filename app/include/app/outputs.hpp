@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -9,6 +10,7 @@
 
 #include "app/batch.hpp"
 #include "app/profile.hpp"
+#include "gfx/exchange.hpp"
 #include "gfx/renderer.hpp"
 #include "nc/toolpath.hpp"
 
@@ -41,6 +43,15 @@ std::uint64_t write_samples_csv(const std::string& path, nc::Emulator& emulator)
 // The checks' keys of metrics.json (docs/formats.md#events): checks, event_errors,
 // event_warnings and the "events" array (fields as the columns of events.csv).
 void put_events_json(const std::vector<verify::Event>& events, bool checks, nlohmann::json& j);
+// Events shown as status-bar alarms by view and run (the newest ones).
+inline constexpr int kShownEventAlarms = 3;
+// The newest `shown` of `events` as status-bar alarms, newest first ("shank-in-material T1
+// line 12: 341.2 mm3 at X.. Y.. Z..", with "sample N" after the line for a live stream,
+// `by_sample`), then, when not all are shown, one line counting them all plus `not_stored`
+// (events a live run counted but had no room to keep). The HUD / operator UI of view and run.
+// No allocation.
+void fill_event_alarms(std::span<const verify::Event> events, std::uint64_t not_stored, int shown, bool by_sample,
+                       gfx::LiveStats& stats) noexcept;
 // --design: the comparison's keys of metrics.json (design_*, max_gouge_*; docs/formats.md#metrics-design),
 // for batch, view and run alike.
 void put_design_json(const verify::DesignReport& d, const Profile& profile, nlohmann::json& j);

@@ -19,6 +19,7 @@
 #include "motion/path_sweeps.hpp"
 #include "motion/tool_table.hpp"
 #include "nc/toolpath.hpp"
+#include "verify/collision.hpp"
 
 namespace lbr::app {
 
@@ -43,6 +44,12 @@ struct StreamOptions {
 // tool axes (CL data) stream their segments at the emulator's end times instead. The solid
 // belongs to that thread between start() and stop()/done(). Setup throws like batch (e.g. a
 // tool that is not in the tool table, naming the program line).
+//
+// With the profile's [checks] on, each tick's sweeps go through verify::CollisionChecker
+// before they are subtracted, as in `lbrsim batch` (a run of findings is measured against the
+// stock of its moment), and the newest events are the status bar's alarms. A sampled stream
+// has no G0: a sweep is a rapid when its tip moves faster than the profile's max cutting feed,
+// as in live mode (docs/verification.md#view).
 class PathStreamer {
  public:
   PathStreamer(const Profile& profile, const nc::Toolpath& path, geom::LbrSolid& solid, gfx::SolidExchange& ex,
@@ -65,6 +72,8 @@ class PathStreamer {
   [[nodiscard]] const std::vector<motion::TimedSweep>& sweeps() const noexcept { return sweeps_; }
   // Wall time of each subtract() batch [ms] (valid after stop()/done()).
   [[nodiscard]] const std::vector<double>& batch_ms() const noexcept { return batch_ms_; }
+  // The checks' events since the last restart (valid after stop()/done()).
+  [[nodiscard]] const std::vector<verify::Event>& events() const noexcept { return events_; }
 
  private:
   void loop();
@@ -80,6 +89,10 @@ class PathStreamer {
   bool apply_due(double sim_s, std::size_t& next, geom::MoveId& last, std::vector<geom::SweepRef>& batch);
   // Tools to draw: each channel's milling tool at the end of its latest sweep up to `upto`.
   std::size_t tools_at(std::size_t upto, std::array<gfx::ToolState, gfx::kMaxTools>& out) const;
+  // Sets up the checks for the planned sweeps (`sampled`: rapids by tip speed).
+  void setup_checks(const Profile& profile, const std::vector<ChannelPath>& channels, bool sampled);
+  // Subtracts sweeps [from, to) in checked pieces (CollisionChecker::check()).
+  void subtract_checked(std::size_t from, std::size_t to, std::vector<geom::SweepRef>& batch);
 
   motion::ToolTable tools_;
   std::vector<motion::TimedSweep> sweeps_;
@@ -95,6 +108,11 @@ class PathStreamer {
   std::int64_t line_ = -1;  // source line of channel 0's newest applied sweep
   std::atomic<double> position_s_{0.0};
   std::atomic<std::int64_t> line_pub_{-1};
+  verify::MoveIndex index_;                            // segment ids (streams of segments)
+  std::unique_ptr<verify::CollisionChecker> checker_;  // null: [checks] off
+  std::vector<std::uint8_t> rapid_;                    // per sweep (sampled streams)
+  std::vector<verify::Event> events_;
+  std::vector<std::string> sources_;                   // program of each channel
 };
 
 // The stock `lbrsim batch` would use for these channels (regions = auto sized like batch).

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdio>
 
+#include "app/outputs.hpp"
 #include "sched/rt_thread.hpp"
 
 namespace lbr::app::live {
@@ -13,10 +14,6 @@ namespace {
 // The profile's max cutting feed (verify::rapid_threshold_mm_per_min) [mm/min].
 double rapid_threshold(const Profile& p) {
   return verify::rapid_threshold_mm_per_min(p.machine.max_feed_mm_per_min, p.machine.rapid_mm_per_min);
-}
-
-gfx::AlarmSeverity alarm_severity(verify::Severity s) noexcept {
-  return s == verify::Severity::Error ? gfx::AlarmSeverity::Error : gfx::AlarmSeverity::Warning;
 }
 
 }  // namespace
@@ -102,21 +99,7 @@ void LiveChecks::record(std::size_t k, std::size_t events_before, const std::arr
 }
 
 void LiveChecks::fill_alarms(gfx::LiveStats& stats) const noexcept {
-  stats.alarm_count = 0;
-  const std::size_t n = events_.size();
-  const std::size_t shown = std::min<std::size_t>(n, kShownAlarms);
-  char text[gfx::kAlarmTextChars];
-  for (std::size_t i = 0; i < shown; ++i) {  // newest first
-    const verify::Event& e = events_[n - 1 - i];
-    std::snprintf(text, sizeof text, "%s T%d line %d sample %u: %.1f mm3 at X%.1f Y%.1f Z%.1f", verify::to_string(e.kind),
-                  e.tool, e.line, e.move, e.volume_mm3, e.position.x, e.position.y, e.position.z);
-    gfx::set_alarm(stats.alarms[static_cast<std::size_t>(stats.alarm_count++)], alarm_severity(e.severity()), text);
-  }
-  if (n > shown || dropped_ > 0) {
-    std::snprintf(text, sizeof text, "%llu collision events in all (events.csv when the run ends)",
-                  static_cast<unsigned long long>(n + dropped_));
-    gfx::set_alarm(stats.alarms[static_cast<std::size_t>(stats.alarm_count++)], gfx::AlarmSeverity::Error, text);
-  }
+  fill_event_alarms(events_, dropped_, kShownAlarms, true, stats);
 }
 
 bool LiveChecks::pop_note(EventNote& out) noexcept { return notes_.try_pop(out); }

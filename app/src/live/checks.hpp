@@ -23,6 +23,7 @@
 #include <span>
 #include <vector>
 
+#include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "geom/lbr_solid.hpp"
 #include "gfx/exchange.hpp"
@@ -57,7 +58,7 @@ struct TickSamples {
 class LiveChecks {
  public:
   static constexpr std::size_t kMaxEvents = 4096;
-  static constexpr int kShownAlarms = 3;  // newest events shown in the status bar
+  static constexpr int kShownAlarms = kShownEventAlarms;  // newest events shown in the status bar
   // Kinds one sweep can raise at once: rapid, plunge, shank, holder, spindle nose.
   static constexpr std::size_t kKindsPerSweep = 5;
 
