@@ -69,16 +69,25 @@ std::vector<Vertex> coloured_run(double last_y, const std::string& name) {
   return read_ply(ply);
 }
 
+// The colour family of a PLY vertex: 0 within, -1 gouge (red), +1 excess (blue).
+int family(const std::array<std::uint8_t, 3>& rgb) {
+  if (rgb == gfx::deviation_rgb(0.0f, 0.2f)) return 0;
+  return rgb[0] > rgb[2] ? -1 : 1;
+}
+
 }  // namespace
 
+// Tolerance 0.02 mm: the colours saturate at 10 tolerances, 0.2 mm. The 0.3 mm over-cut is
+// the deep red.
 TEST(DeviationColour, AnOverCutWallIsRedAndNothingElseIs) {
   const std::vector<Vertex> v = coloured_run(55.3, "lbr_deviation_over");
   ASSERT_GT(v.size(), 100u);
-  const auto red = gfx::deviation_rgb(-1.0f), blue = gfx::deviation_rgb(1.0f);
+  const auto deep_red = gfx::deviation_rgb(-1.0f, 0.2f);
   std::size_t reds = 0, blues = 0;
   for (const Vertex& p : v) {
-    if (p.rgb == blue) ++blues;
-    if (p.rgb != red) continue;
+    if (family(p.rgb) == 1) ++blues;
+    if (family(p.rgb) != -1) continue;
+    EXPECT_EQ(p.rgb, deep_red);
     ++reds;
     // On the over-cut wall: Y60.3, from the pocket floor Z-5 up to the top Z0.
     EXPECT_NEAR(p.y, 60.3, 0.01) << p.x << " " << p.y << " " << p.z;
@@ -91,8 +100,45 @@ TEST(DeviationColour, AnOverCutWallIsRedAndNothingElseIs) {
 
 TEST(DeviationColour, AnExactCutHasNoGougeOrExcessColour) {
   const std::vector<Vertex> v = coloured_run(55.0, "lbr_deviation_exact");
-  const auto within = gfx::deviation_rgb(0.0f);
+  const auto within = gfx::deviation_rgb(0.0f, 0.2f);
   std::size_t others = 0;
   for (const Vertex& p : v) others += p.rgb != within;
   EXPECT_EQ(others, 0u);
+}
+
+// The gradient: on a 0.1 mm over-cut the wall's values are 0.10–0.11 mm (the over-cut, up to
+// half the tolerance more by the probe's offset along the vertex normal,
+// docs/verification.md#deviation-colour): half-way from the light to the deep red, and
+// clearly lighter than the 0.3 mm over-cut's deep red (-0.09 .. -0.12 mm asserted).
+TEST(DeviationColour, AShallowerOverCutIsALighterRed) {
+  const std::vector<Vertex> v = coloured_run(55.1, "lbr_deviation_shallow");
+  const auto lighter = gfx::deviation_rgb(-0.09f, 0.2f), deeper = gfx::deviation_rgb(-0.12f, 0.2f);
+  std::size_t reds = 0;
+  for (const Vertex& p : v) {
+    if (family(p.rgb) != -1) continue;
+    ++reds;
+    EXPECT_NEAR(p.y, 60.1, 0.01);
+    for (int c = 0; c < 3; ++c) {  // every channel falls from the light to the deep shade
+      EXPECT_LE(p.rgb[c], lighter[c]) << c;
+      EXPECT_GE(p.rgb[c], deeper[c]) << c;
+    }
+  }
+  EXPECT_GT(reds, 10u);
+}
+
+TEST(DeviationColour, GradientRunsFromLightToDeepAndSaturatesAtTheScale) {
+  const auto light = gfx::deviation_rgb(-1e-4f, 0.2f), mid = gfx::deviation_rgb(-0.1f, 0.2f),
+             deep = gfx::deviation_rgb(-0.2f, 0.2f);
+  EXPECT_EQ(gfx::deviation_rgb(-5.0f, 0.2f), deep);
+  EXPECT_EQ(deep, (std::array<std::uint8_t, 3>{181, 10, 10}));
+  EXPECT_EQ(light, (std::array<std::uint8_t, 3>{240, 153, 140}));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mid[c], 0.5 * (light[c] + deep[c]), 1.0) << c;
+  EXPECT_EQ(gfx::deviation_rgb(0.2f, 0.2f), (std::array<std::uint8_t, 3>{20, 51, 199}));
+  const std::vector<gfx::LegendRow> legend = gfx::deviation_legend(0.2);
+  ASSERT_EQ(legend.size(), 5u);
+  EXPECT_EQ(legend[0].rgb, deep);
+  EXPECT_EQ(legend[0].text, "gouge >= 0.200 mm");
+  EXPECT_EQ(legend[2].text, "within tolerance 0.020 mm");
+  EXPECT_EQ(legend[2].rgb, gfx::deviation_rgb(0.0f, 0.2f));
+  EXPECT_EQ(legend[4].rgb, gfx::deviation_rgb(0.2f, 0.2f));
 }

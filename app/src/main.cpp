@@ -157,7 +157,10 @@ void write_png_if_asked(const app::BatchResult& r, const BatchOptions& o, const 
                         const std::vector<gfx::ToolState>& tools) {
   if (o.png.empty()) return;
   gfx::CaptureOptions c = cap;
-  if (deviation_colours(o)) c.deviation = app::deviation_fn(r.design_sections, r.solid, o.design_tolerance);
+  if (deviation_colours(o)) {
+    c.deviation = app::deviation_fn(r.design_sections, r.solid, o.design_tolerance);
+    c.deviation_scale_mm = gfx::kDeviationScalePerTolerance * o.design_tolerance;
+  }
   // A picture of the finished part: the tool would hide part of it (issue 19), so it is
   // drawn only with --show-tool.
   gfx::capture_png(r.solid, o.png, c, o.show_tool && !o.no_tool ? tools : std::vector<gfx::ToolState>{});
@@ -529,8 +532,10 @@ app::LiveResult run_live_rendered(const RunOptions& o, const app::Profile& profi
   std::unique_ptr<geom::LbrSolid> start = initial_ready.get();
   if (start) {
     // --color deviation: the colours from the design sections on the stock's levels (kept in `start`).
-    if (rc.render.color == gfx::ColorMode::Deviation && !design.empty())
+    if (rc.render.color == gfx::ColorMode::Deviation && !design.empty()) {
       rc.render.deviation = app::deviation_fn(design, *start, o.design_tolerance);
+      rc.render.deviation_scale_mm = gfx::kDeviationScalePerTolerance * o.design_tolerance;
+    }
     gfx::RenderThread rt(win, ex, *start, rc);
     if (!rc.render.deviation) start.reset();
     rt.start();

@@ -250,7 +250,8 @@ void write_mesh_files(const geom::LbrSolid& solid, const std::string& stl_path, 
     for (const mesh::MeshBuffers& m : regions) {
       verify::vertex_deviation(*colours.design, solid, m.positions, m.normals, colours.tolerance_mm, dev);
       for (float d : dev) {
-        const std::array<std::uint8_t, 3> c = gfx::deviation_rgb(d);
+        const std::array<std::uint8_t, 3> c =
+            gfx::deviation_rgb(d, static_cast<float>(gfx::kDeviationScalePerTolerance * colours.tolerance_mm));
         rgb.insert(rgb.end(), c.begin(), c.end());
       }
     }

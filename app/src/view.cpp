@@ -319,8 +319,10 @@ std::unique_ptr<geom::LbrSolid> publish_batch_result(const Profile& profile, con
 void apply_design(const Profile& profile, const ViewDesign& design, const geom::LbrSolid& solid,
                   gfx::RenderThreadConfig& rc) {
   const double tol = profile.design.tolerance_mm;
-  if (rc.render.color == gfx::ColorMode::Deviation && !design.sections.empty())
+  if (rc.render.color == gfx::ColorMode::Deviation && !design.sections.empty()) {
     rc.render.deviation = deviation_fn(design.sections, solid, tol);
+    rc.render.deviation_scale_mm = gfx::kDeviationScalePerTolerance * tol;
+  }
   if (!design.report) return;
   rc.render.design = design_summary(*design.report, tol);
   std::printf("design: %s\n", rc.render.design.c_str());

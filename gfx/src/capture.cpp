@@ -29,6 +29,7 @@ void capture_png(const geom::LbrSolid& solid, const std::string& path, const Cap
   ro.show_tools = !tools.empty();
   ro.show_path = !tool_path.empty();
   ro.deviation = opt.deviation;
+  ro.deviation_scale_mm = opt.deviation_scale_mm;
   Renderer ren(solid, ro);
   ren.set_tools(tools);
   ren.set_path(tool_path);

@@ -42,6 +42,17 @@ in vec4 v_col;
 out vec4 o_col;
 void main() { o_col = v_col; })";
 
+constexpr float kSwatchWidth = 14.0f;  // font units a swatch column takes
+
+// Lines and the longest line of `text` [characters].
+std::pair<std::size_t, std::size_t> text_extent(const std::string& text) {
+  std::size_t lines = 1, longest = 0, cur = 0;
+  for (char ch : text) {
+    if (ch == '\n') { ++lines; longest = std::max(longest, cur); cur = 0; } else { ++cur; }
+  }
+  return {lines, std::max(longest, cur)};
+}
+
 }  // namespace
 
 Hud::Hud() {
@@ -72,11 +83,7 @@ void Hud::draw(const std::string& text, int w, int h, float scale) { draw_panel(
 
 void Hud::draw_alarm_band(const std::string& text, int w, int h, float scale) {
   if (text.empty() || w <= 0 || h <= 0) return;
-  std::size_t lines = 1, longest = 0, cur = 0;
-  for (char ch : text) {
-    if (ch == '\n') { ++lines; longest = std::max(longest, cur); cur = 0; } else { ++cur; }
-  }
-  longest = std::max(longest, cur);
+  const auto [lines, longest] = text_extent(text);
   const float pw = 6.0f * static_cast<float>(longest) + 8.0f, ph = 12.0f * static_cast<float>(lines) + 4.0f;
   scale = std::clamp(static_cast<float>(w) / pw, 1.0f, scale);  // as draw_panel() will
   Panel band;
@@ -87,26 +94,45 @@ void Hud::draw_alarm_band(const std::string& text, int w, int h, float scale) {
   draw_panel(text, w, h, scale, band);
 }
 
+void Hud::draw_legend(const std::string& text, const std::vector<std::array<std::uint8_t, 3>>& swatches, int w, int h,
+                      float scale) {
+  if (text.empty() || w <= 0 || h <= 0) return;
+  const auto [lines, longest] = text_extent(text);
+  const float tw = 6.0f * static_cast<float>(longest) + 8.0f + kSwatchWidth, ph = 12.0f * static_cast<float>(lines) + 4.0f;
+  scale = std::clamp(static_cast<float>(w) / tw, 1.0f, scale);  // as draw_panel() will
+  Panel p;  // at the right edge, half-way down: clear of the HUD (top left) and the alarm band (bottom)
+  p.x = std::max(0.0f, static_cast<float>(w) / scale - tw - 4.0f);
+  p.y = std::max(0.0f, 0.5f * (static_cast<float>(h) / scale - ph));
+  p.swatches = &swatches;
+  draw_panel(text, w, h, scale, p);
+}
+
 void Hud::draw_panel(const std::string& text, int w, int h, float scale, const Panel& panel) {
   if (text.empty() || w <= 0 || h <= 0) return;
   // Panel first (one quad), then the glyph quads.
   std::vector<FontVertex> verts;
-  std::size_t lines = 1, longest = 0, cur = 0;
-  for (char ch : text) {
-    if (ch == '\n') { ++lines; longest = std::max(longest, cur); cur = 0; } else { ++cur; }
-  }
-  longest = std::max(longest, cur);
-  const float tw = 6.0f * static_cast<float>(longest) + 8.0f, ph = 12.0f * static_cast<float>(lines) + 4.0f;
+  const auto [lines, longest] = text_extent(text);
+  const float sw = panel.swatches != nullptr ? kSwatchWidth : 0.0f;
+  const float tw = 6.0f * static_cast<float>(longest) + 8.0f + sw, ph = 12.0f * static_cast<float>(lines) + 4.0f;
   scale = std::clamp(static_cast<float>(w) / tw, 1.0f, scale);  // fit narrow viewports
   const float pw = std::max(tw, panel.min_width), x0 = panel.x, y0 = panel.y;
   for (auto [x, y] : {std::pair{x0, y0}, {x0 + pw, y0}, {x0 + pw, y0 + ph}, {x0, y0 + ph}}) {
     FontVertex v{x, y, 0, {panel.bg[0], panel.bg[1], panel.bg[2], panel.bg[3]}};
     verts.push_back(v);
   }
+  if (panel.swatches != nullptr) {
+    for (std::size_t i = 0; i < std::min(lines, panel.swatches->size()); ++i) {
+      const auto& c = (*panel.swatches)[i];
+      const float sx = x0 + 4.0f, sy = y0 + 3.0f + 12.0f * static_cast<float>(i);
+      for (auto [x, y] : {std::pair{sx, sy}, {sx + 10.0f, sy}, {sx + 10.0f, sy + 9.0f}, {sx, sy + 9.0f}})
+        verts.push_back(FontVertex{x, y, 0, {c[0], c[1], c[2], 255}});
+    }
+  }
   buf_.resize(text.size() * 270 + 1024);
   std::string copy = text;
   unsigned char col[4] = {235, 240, 245, 255};
-  const int quads = stb_easy_font_print(x0 + 4.0f, y0 + 4.0f, copy.data(), col, buf_.data(), static_cast<int>(buf_.size()));
+  const int quads =
+      stb_easy_font_print(x0 + 4.0f + sw, y0 + 4.0f, copy.data(), col, buf_.data(), static_cast<int>(buf_.size()));
   const auto* fv = reinterpret_cast<const FontVertex*>(buf_.data());
   verts.insert(verts.end(), fv, fv + 4 * quads);
   const std::size_t nq = verts.size() / 4;

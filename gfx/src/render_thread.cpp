@@ -28,7 +28,7 @@ RenderThread::RenderThread(Window& win, SolidExchange& exchange, const geom::Lbr
   cam_.set_view(cfg_.view);
   cam_.ortho = cfg_.ortho;
   ui_on_ = cfg_.ui.enabled && win_.visible();
-  if (ui_on_) opt_.show_hud = false;  // the status bar shows the HUD's figures
+  if (ui_on_) opt_.show_hud = opt_.show_legend = false;  // the status bar and view panel show them
 }
 
 RenderThread::~RenderThread() { stop(); }

@@ -137,7 +137,9 @@ void main() {
   if (u_mode == 1) {
     base = (v_attr < 0.5 || on_stock_face(v_pos)) ? vec3(0.60, 0.61, 0.63) : heat(v_attr / max(u_max_attr, 1.0));
   } else if (u_mode == 5) {
-    base = v_attr < 0.0 ? vec3(0.86, 0.12, 0.10) : (v_attr > 0.0 ? vec3(0.15, 0.35, 0.90) : vec3(0.55, 0.66, 0.55));
+    float t = clamp(abs(v_attr) / max(u_max_attr, 1e-6), 0.0, 1.0);
+    base = v_attr < 0.0 ? mix(vec3(0.94, 0.60, 0.55), vec3(0.71, 0.04, 0.04), t)
+                        : (v_attr > 0.0 ? mix(vec3(0.60, 0.69, 0.96), vec3(0.08, 0.20, 0.78), t) : vec3(0.55, 0.66, 0.55));
   }
   vec3 L = normalize(u_key);
   vec3 F = normalize(vec3(-u_key.x, -u_key.y, 0.35));  // fill from the opposite side
@@ -185,11 +187,30 @@ ColorMode parse_color_mode(const std::string& s) {
   throw std::invalid_argument("unknown colour mode '" + s + "' (expected plain, heat, regions or deviation)");
 }
 
-std::array<std::uint8_t, 3> deviation_rgb(float d_mm) noexcept {
-  // As kMeshFs's deviation(): gouge (0.86, 0.12, 0.10), excess (0.15, 0.35, 0.90), within (0.55, 0.66, 0.55).
-  if (d_mm < 0.0f) return {219, 31, 26};
-  if (d_mm > 0.0f) return {38, 89, 230};
-  return {140, 168, 140};
+std::array<std::uint8_t, 3> deviation_rgb(float d_mm, float scale_mm) noexcept {
+  // As kMeshFs's mode 5: light (0.94, 0.60, 0.55) to deep (0.71, 0.04, 0.04) red, light
+  // (0.60, 0.69, 0.96) to deep (0.08, 0.20, 0.78) blue, within (0.55, 0.66, 0.55).
+  if (d_mm == 0.0f) return {140, 168, 140};
+  const float t = std::clamp(std::fabs(d_mm) / std::max(scale_mm, 1e-6f), 0.0f, 1.0f);
+  auto mix = [t](float a, float b) { return static_cast<std::uint8_t>(std::lround(255.0f * (a + (b - a) * t))); };
+  if (d_mm < 0.0f) return {mix(0.94f, 0.71f), mix(0.60f, 0.04f), mix(0.55f, 0.04f)};
+  return {mix(0.60f, 0.08f), mix(0.69f, 0.20f), mix(0.96f, 0.78f)};
+}
+
+std::vector<LegendRow> deviation_legend(double scale_mm) {
+  const auto s = static_cast<float>(scale_mm);
+  char buf[64];
+  std::vector<LegendRow> rows;
+  auto row = [&](float d, const char* fmt, double v) {
+    std::snprintf(buf, sizeof buf, fmt, v);
+    rows.push_back({deviation_rgb(d, s), buf});
+  };
+  row(-s, "gouge >= %.3f mm", scale_mm);
+  row(-0.5f * s, "gouge    %.3f mm", 0.5 * scale_mm);
+  row(0.0f, "within tolerance %.3f mm", scale_mm / kDeviationScalePerTolerance);
+  row(0.5f * s, "excess   %.3f mm", 0.5 * scale_mm);
+  row(s, "excess >= %.3f mm", scale_mm);
+  return rows;
 }
 
 const char* to_string(ColorMode m) noexcept {
@@ -413,6 +434,7 @@ FrameInfo Renderer::frame(const Camera& cam, int w, int h) {
   if (opt_.show_outline) draw_outline();
   glBindVertexArray(0);
   if (opt_.show_hud) draw_hud(w, h);
+  if (opt_.show_legend && opt_.color == ColorMode::Deviation && opt_.deviation) draw_legend(w, h);
   fi.draw_ms = std::chrono::duration<double, std::milli>(clock::now() - t2).count();
   last_ = fi;
   return fi;
@@ -553,7 +575,9 @@ void Renderer::set_scene_uniforms(const Camera& cam, const glm::dmat4& vp) {
   const geom::Box3 sb = stock_box();
   glUniform3f(g.u_lo, static_cast<float>(sb.lo.x), static_cast<float>(sb.lo.y), static_cast<float>(sb.lo.z));
   glUniform3f(g.u_hi, static_cast<float>(sb.hi.x), static_cast<float>(sb.hi.y), static_cast<float>(sb.hi.z));
-  glUniform1f(g.u_max_attr, static_cast<float>(std::max<geom::MoveId>(last_move_, 1)));
+  // Heat: the newest move id; deviation: the colours' scale [mm].
+  glUniform1f(g.u_max_attr, opt_.color == ColorMode::Deviation ? static_cast<float>(opt_.deviation_scale_mm)
+                                                               : static_cast<float>(std::max<geom::MoveId>(last_move_, 1)));
 }
 
 // Each tool as three cylinders (flutes, shank, holder) in its pose.
@@ -685,6 +709,17 @@ void Renderer::draw_alarms(int w, int h) {
     used += static_cast<std::size_t>(k);
   }
   gl_->hud->draw_alarm_band(buf, w, h);
+}
+
+// The deviation colours' legend at the right edge (deviation_legend()), smaller than the HUD.
+void Renderer::draw_legend(int w, int h) {
+  std::string text;
+  std::vector<std::array<std::uint8_t, 3>> swatches;
+  for (const LegendRow& r : deviation_legend(opt_.deviation_scale_mm)) {
+    text += (text.empty() ? "" : "\n") + r.text;
+    swatches.push_back(r.rgb);
+  }
+  gl_->hud->draw_legend(text, swatches, w, h, 1.5f);
 }
 
 FrameInfo Renderer::frame_offscreen(const Camera& cam, int w, int h) {

@@ -319,6 +319,17 @@ void Ui::display_toggles(UiActions& act) {
   if (toggle_button("Path", o.show_path, b3)) { o.show_path = !o.show_path; act.options_changed = true; }
   ImGui::SameLine();
   if (toggle_button("Stock", o.show_outline, b3)) { o.show_outline = !o.show_outline; act.options_changed = true; }
+  if (o.color == ColorMode::Deviation && o.deviation) deviation_legend_rows(o.deviation_scale_mm);
+}
+
+void Ui::deviation_legend_rows(double scale_mm) {
+  const float side = ImGui::GetTextLineHeight();
+  for (const LegendRow& r : deviation_legend(scale_mm)) {
+    const ImVec4 c(r.rgb[0] / 255.0f, r.rgb[1] / 255.0f, r.rgb[2] / 255.0f, 1.0f);
+    ImGui::ColorButton(r.text.c_str(), c, ImGuiColorEditFlags_NoTooltip | ImGuiColorEditFlags_NoPicker, ImVec2(side, side));
+    ImGui::SameLine();
+    ImGui::TextUnformatted(r.text.c_str());
+  }
 }
 
 void Ui::section_controls(UiActions& act) {

@@ -81,6 +81,8 @@ class Ui {
   void view_panel(const UiFrameInput& in, UiActions& act);
   void view_buttons(UiActions& act);
   void display_toggles(UiActions& act);
+  // The deviation colours' legend (gfx::deviation_legend) under the toggles.
+  void deviation_legend_rows(double scale_mm);
   void section_controls(UiActions& act);
   void replay_bar(const Renderer& ren);
   void time_slider(ReplayControl& rc, const LiveStats& L);

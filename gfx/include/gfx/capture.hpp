@@ -18,6 +18,7 @@ struct CaptureOptions {
   bool ortho = false;  // orthographic projection (the default for the top view)
   bool hud = false;
   DeviationFn deviation;  // ColorMode::Deviation's per-vertex values (RenderOptions::deviation)
+  double deviation_scale_mm = 0.2;  // RenderOptions::deviation_scale_mm (the image has the legend)
 };
 
 // Parses "WxH" (e.g. 1024x768); throws std::invalid_argument.

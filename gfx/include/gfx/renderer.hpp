@@ -24,9 +24,22 @@ enum class ColorMode { Plain, Heat, Regions, Deviation };
 [[nodiscard]] const char* to_string(ColorMode m) noexcept;
 
 // Deviation colouring (docs/verification.md#deviation-colour): the colour of a vertex with
-// signed deviation `d_mm` from the design model (< 0 gouge: red, > 0 excess: blue, 0 within
-// the tolerance: grey-green). The mesh shader uses the same three colours.
-[[nodiscard]] std::array<std::uint8_t, 3> deviation_rgb(float d_mm) noexcept;
+// signed deviation `d_mm` from the design model: 0 (within the tolerance) grey-green; a gouge
+// (< 0) red and an excess (> 0) blue, each from a light shade near 0 to a deep one at
+// |d| >= `scale_mm` (linear in between). The mesh shader computes the same colours.
+[[nodiscard]] std::array<std::uint8_t, 3> deviation_rgb(float d_mm, float scale_mm) noexcept;
+// The deviation the colours saturate at, per unit of the comparison's tolerance: the gradient
+// spans the tolerance band's edge (half the tolerance) to ten tolerances (0.2 mm at 0.02).
+inline constexpr double kDeviationScalePerTolerance = 10.0;
+// One row of the deviation colours' legend.
+struct LegendRow {
+  std::array<std::uint8_t, 3> rgb;
+  std::string text;
+};
+// The legend of deviation_rgb() at `scale_mm` (HUD, operator UI, --png): a gouge at the scale
+// and at half of it, within the tolerance (scale / kDeviationScalePerTolerance), an excess at
+// half the scale and at it.
+[[nodiscard]] std::vector<LegendRow> deviation_legend(double scale_mm);
 // Fills `out` with the signed deviation [mm] of every vertex of `mesh` (the app computes it
 // from a design model, verify::vertex_deviation).
 using DeviationFn = std::function<void(const mesh::MeshBuffers& mesh, std::vector<float>& out)>;
@@ -45,6 +58,8 @@ struct RenderOptions {
   std::string notice;  // a warning line on the HUD (e.g. input that does not match the profile)
   std::string design;  // the design comparison's figures on the HUD (--design: gouge, excess); empty: none
   DeviationFn deviation;  // ColorMode::Deviation's per-vertex values; empty: that mode draws plain
+  double deviation_scale_mm = 0.2;  // deviation_rgb()'s scale_mm (the legend shows it)
+  bool show_legend = true;          // the deviation legend at the right edge (off under the operator UI, which has its own)
   mesh::MeshOptions mesh;
   int max_regions_per_frame = 16;   // upper bound of the adaptive per-frame rebuild limit
   double mesh_budget_ms = 12.0;     // rebuild time per frame the limit adapts to [ms]
@@ -133,6 +148,7 @@ class Renderer {
   void draw_outline();
   void draw_hud(int w, int h);
   void draw_alarms(int w, int h);
+  void draw_legend(int w, int h);
 
   RenderOptions opt_;
   MeshMirror mirror_;
