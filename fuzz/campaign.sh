@@ -37,7 +37,10 @@ for t in "${TARGETS[@]}"; do
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$last")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$last")
   corp=$(sed -n 's/.* corp: \([0-9]*\).*/\1/p' <<<"$last")
-  crashes=$(find "$d/artifacts" -type f | wc -l)
-  printf "%-12s %12s %9s %7s %8s %7s %7s %s%s\n" "$t" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" \
-    "$crashes" "$secs" "$([ "$rc" = 0 ] || echo " (exit $rc)")"
+  # Findings: crash-, leak-, timeout- and oom- files; slow-unit- files (inputs over libFuzzer's
+  # -report_slow_units seconds) are counted apart: they are not failures.
+  crashes=$(find "$d/artifacts" -type f ! -name 'slow-unit-*' | wc -l)
+  slow=$(find "$d/artifacts" -type f -name 'slow-unit-*' | wc -l)
+  printf "%-12s %12s %9s %7s %8s %7s %7s %s%s%s\n" "$t" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" \
+    "$crashes" "$secs" "$([ "$rc" = 0 ] || echo " (exit $rc)")" "$([ "$slow" = 0 ] || echo " ($slow slow units)")"
 done
