@@ -436,6 +436,30 @@ TEST(SampledChecks, ACutAfterM5RaisesSpindleOffAtItsLine) {
   EXPECT_TRUE(good.events.empty()) << verify::describe(good.events.at(0));
 }
 
+// A program that never starts the spindle cuts a D10 slot 2 deep from X-10 to X60 across
+// the stock's X0 face: 60 x 10 plus the half disc at X60, 639.27 mm2 x 2 = 1278.5 mm3, in
+// ~175 samples. Every cutting sample is a spindle-off finding; the run is one event, tested
+// for contact after its first sample, and it ends its batch there: the event takes the
+// volume the kernel removed for the run (exact, not the first sample's lower bound), and the
+// run costs two kernel calls more than the unchecked cut, not one per sample.
+TEST(SampledChecks, ARunOfSpindleOffSamplesIsOneEventWithTheVolumeTheKernelRemoved) {
+  const std::string prog = "G21 G90 G17\nT1 M6 G43 H1\nG0 X-10 Y40 Z5\nG1 Z-2 F300\nG1 X60 F600\nG0 Z10\nM2\n";
+  app::Profile p = app::default_profile();
+  const app::BatchResult checked = run_sampled(p, prog);
+  p.checks.enabled = false;
+  const app::BatchResult unchecked = run_sampled(p, prog);
+  ASSERT_EQ(checked.events.size(), 1u) << verify::describe(checked.events.at(1));
+  const verify::Event& e = checked.events[0];
+  EXPECT_EQ(e.kind, verify::EventKind::SpindleOff);
+  EXPECT_EQ(e.line, 5);
+  EXPECT_GE(e.moves, 100u);
+  const double slot_mm3 = (600.0 + 12.5 * std::numbers::pi) * 2.0;
+  EXPECT_NEAR(e.volume_mm3, slot_mm3, 0.01 * slot_mm3);
+  EXPECT_NEAR(e.volume_mm3, checked.removed_volume_mm3, 1e-6 * slot_mm3);  // the run is all the cutting
+  EXPECT_LE(checked.batches, unchecked.batches + 2) << "unchecked: " << unchecked.batches;
+  EXPECT_NEAR(checked.removed_volume_mm3, unchecked.removed_volume_mm3, 1e-6 * slot_mm3);
+}
+
 // The feed limit judges the sample speed: F1500 over a 1000 mm/min limit while cutting is a
 // warning at its line with the feed reached (the emulator runs at the programmed feed) and
 // about its 600 mm3 (the deceleration's last 0.14 mm below the limit are not counted).

@@ -94,7 +94,9 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
           checker->check(r.solid, moves, rapid, begin, std::min(begin + per, moves.size()), r.events, true);
       fill(begin, end, batch);
       begin += cut_loops(batch, begin);
+      const double before_mm3 = r.solid.volume_mm3();
       const geom::SubtractStats s = pool.subtract(r.solid, batch);
+      checker->settle(before_mm3 - r.solid.volume_mm3(), begin == end, r.events);
       r.stats += s;
       done(s);
     }

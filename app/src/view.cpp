@@ -120,7 +120,9 @@ void PathStreamer::subtract_checked(std::size_t from, std::size_t to, std::vecto
     }
     batch.clear();
     for (std::size_t k = from; k < end; ++k) batch.push_back(sweeps_[k].ref);
+    const double before_mm3 = checker_ ? solid_.volume_mm3() : 0.0;
     solid_.subtract(batch);
+    if (checker_) checker_->settle(before_mm3 - solid_.volume_mm3(), true, events_);
     from = end;
   }
 }

@@ -8,13 +8,18 @@ namespace lbr::verify {
 
 namespace {
 
-// The kinds of the parts that do not cut (shank, holder, spindle nose): the only ones a run
-// may continue with (CollisionChecker::check_moves()). A cutting sweep's kinds (rapid,
-// spindle off, feed limit, plunge) remove what they meet, so each such move is measured
-// against the stock of its exact moment.
+// The kinds a run may continue with (CollisionChecker::check_moves()): the parts that do not
+// cut (shank, holder, spindle nose), whose later moves are tested for contact only, and the
+// kinds of the cutting sweep itself (rapid, spindle off, feed limit), whose run ends its batch
+// and takes the volume the kernel removed for it (settle()). A plunge's core is measured
+// move by move against the stock of its exact moment.
 constexpr unsigned kPartKinds = (1u << static_cast<unsigned>(EventKind::ShankInMaterial)) |
                                 (1u << static_cast<unsigned>(EventKind::HolderInMaterial)) |
                                 (1u << static_cast<unsigned>(EventKind::SpindleNoseInMaterial));
+constexpr unsigned kSweepKinds = (1u << static_cast<unsigned>(EventKind::RapidIntoMaterial)) |
+                                 (1u << static_cast<unsigned>(EventKind::SpindleOff)) |
+                                 (1u << static_cast<unsigned>(EventKind::FeedLimit));
+constexpr unsigned kRunKinds = kPartKinds | kSweepKinds;
 
 
 geom::Pose raised(const geom::Pose& p, double h_mm) {
@@ -173,29 +178,48 @@ std::size_t CollisionChecker::check(const geom::LbrSolid& solid, std::span<const
 std::size_t CollisionChecker::check_moves(const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                                           std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to,
                                           std::vector<Event>& events, bool runs) {
+  settle_.clear();
+  run_moves_ = 0;
   if (!config_.enabled) return to;
   Findings found;
   unsigned before = 0;  // the kinds the move before raised (bit per EventKind), 0: clean
   for (std::size_t i = from; i < to; ++i) {
     // After a move with findings, the next is first tested for contact only: if it continues
     // the run (the same kinds), it extends the run's events without adding volume or depth.
-    contact_only_ = runs && i > from && before != 0 && (before & ~kPartKinds) == 0;
+    contact_only_ = runs && i > from && before != 0 && (before & ~kRunKinds) == 0;
     const int n = findings_of(solid, moves[i], rapid.empty() ? -1 : (rapid[i] != 0 ? 1 : 0), found);
     unsigned kinds = 0;
     for (int k = 0; k < n; ++k) kinds |= 1u << static_cast<unsigned>(found[k].kind);
-    // A move that starts a run of findings is checked again against the stock of its moment.
-    if (n > 0 && i > from && (!runs || kinds != before || (kinds & ~kPartKinds) != 0)) {
+    // A move that starts a run of findings is checked again against the stock of its moment;
+    // a run of the cutting sweep's kinds ends its batch with its last move (settle()).
+    const bool continues = kinds == before;
+    if (i > from && ((n > 0 && (!runs || !continues || (kinds & ~kRunKinds) != 0)) || (run_moves_ > 1 && !continues))) {
       contact_only_ = false;
+      if (run_moves_ < 2) settle_.clear();
       return i;
     }
+    if (i == from) run_moves_ = (kinds & kSweepKinds) != 0 ? 1 : 0;
+    else if (run_moves_ > 0) run_moves_ = continues ? run_moves_ + 1 : 0;  // 0: a one-move run, measured whole
+    if (run_moves_ == 0) settle_.clear();
     before = kinds;
     for (int k = 0; k < n; ++k) {
       if (contact_only_) found[k].what.volume_mm3 = found[k].what.depth_mm = 0.0;
-      add_event(events, event_of(moves[i], found[k]));
+      const std::size_t at = add_event(events, event_of(moves[i], found[k]));
+      if (i == from && (kSweepKinds >> static_cast<unsigned>(found[k].kind) & 1u) != 0)
+        settle_.push_back({at, found[k].what.volume_mm3});
     }
   }
   contact_only_ = false;
+  if (run_moves_ < 2) settle_.clear();
   return to;
+}
+
+void CollisionChecker::settle(double removed_mm3, bool whole, std::vector<Event>& events) {
+  if (whole)
+    for (const auto& [at, first_mm3] : settle_)
+      if (at < events.size()) events[at].volume_mm3 += std::max(0.0, removed_mm3 - first_mm3);
+  settle_.clear();
+  run_moves_ = 0;
 }
 
 void check_travel(const nc::Toolpath& path, const nc::AxisVector& min, const nc::AxisVector& max, int channel,

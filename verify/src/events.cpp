@@ -120,7 +120,7 @@ std::string describe(const Event& e) {
   return s + buf;
 }
 
-void add_event(std::vector<Event>& events, const Event& e) {
+std::size_t add_event(std::vector<Event>& events, const Event& e) {
   // One move can raise several kinds at once (shank and holder), so the run to extend is
   // looked for among the last few events.
   constexpr std::size_t kKinds = 7;  // the kinds one move can raise in CollisionChecker::check()
@@ -135,12 +135,13 @@ void add_event(std::vector<Event>& events, const Event& e) {
     last.volume_mm3 += e.volume_mm3;
     last.depth_mm = std::max(last.depth_mm, e.depth_mm);
     last.value = std::max(last.value, e.value);
-    return;
+    return events.size() - 1 - back;
   }
   Event first = e;
   first.last_move = e.move;
   first.last_line = e.line;
   events.push_back(first);
+  return events.size() - 1;
 }
 
 }  // namespace lbr::verify

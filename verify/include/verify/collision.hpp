@@ -26,6 +26,7 @@
 #include <map>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geom/lbr_solid.hpp"
@@ -112,6 +113,13 @@ class CollisionChecker {
                     std::span<const std::uint8_t> rapid, std::size_t from, std::size_t to, std::vector<Event>& events,
                     bool runs = false);
 
+  // After check(…, runs = true) whose moves [from, end) were subtracted: a run of the cutting
+  // sweep's own kinds (rapid-into-material, spindle-off, feed-limit) that continued past
+  // moves[from] ends its batch, and its events take `removed_mm3`, the volume the kernel
+  // removed for those moves, in place of the lower bound the contact tests give (the first
+  // move's measured volume is replaced, not added twice). `whole` false (the caller subtracted
+  // fewer moves than check() returned): nothing changes. Either way the pending run is dropped.
+  void settle(double removed_mm3, bool whole, std::vector<Event>& events);
   [[nodiscard]] const CheckConfig& config() const noexcept { return config_; }
 
  private:
@@ -135,6 +143,10 @@ class CollisionChecker {
                           std::vector<Event>& events, bool runs);
   static constexpr int kMaxFindings = 7;
   bool contact_only_ = false;  // check(): the move continues a run (IntrusionProbe::measure)
+  // The last check()'s run of the cutting sweep's kinds: its length from moves[from] (0: none),
+  // and each of moves[from]'s events of those kinds with the volume it measured (settle()).
+  std::size_t run_moves_ = 0;
+  std::vector<std::pair<std::size_t, double>> settle_;
   using Findings = Finding[kMaxFindings];
   // The findings of one move against `solid`; returns how many were written. `rapid`: 1 / 0
   // the move is / is not a rapid, -1 the move's program segment tells.

@@ -75,6 +75,7 @@ struct EventCounts {
 // several kinds) when that one is the same kind, tool, channel and axis and `e`'s move follows
 // its last move directly (same id: another sub-step
 // of a rotary move; id + 1: the next segment or sample).
-void add_event(std::vector<Event>& events, const Event& e);
+// Returns the index of the event `e` went to.
+std::size_t add_event(std::vector<Event>& events, const Event& e);
 
 }  // namespace lbr::verify
