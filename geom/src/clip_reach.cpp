@@ -137,26 +137,39 @@ bool build_frame(ReachScratch& rs, ReachFrame& f) {
   rs.sorted.clear();
   rs.wide.clear();
   rs.chunks.clear();
+  const V2 o{f.ox, f.oy};
   for (std::uint32_t i = 0; i < rs.items.size(); ++i) {
     ReachScratch::Item& it = rs.items[i];
     const ReachCapsule& c = rs.caps[it.k];
     const V2 a{c.ax, c.ay}, b{c.bx, c.by};
-    const V2 o{f.ox, f.oy};
     f.rho_max = std::max(f.rho_max, std::sqrt(std::max(dist2_point_segment(a, o, o), dist2_point_segment(b, o, o))));
-    const double near2 = dist2_point_segment(o, a, b);
-    f.rho_min = std::min(f.rho_min, std::sqrt(near2));
-    double span = kPeriod;  // (a segment through the centre's unit disk is wide)
-    if (near2 >= 1.0) interval_of_segment(a, b, o, it.lo, span);
-    it.wide = span > kNarrowRad;
-    (it.wide ? rs.wide : rs.sorted).push_back(i);
+    f.rho_min = std::min(f.rho_min, std::sqrt(dist2_point_segment(o, a, b)));
     if (i % kChunk == 0) rs.chunks.push_back(ReachScratch::Chunk{it.box, i, i + 1});
     grow(rs.chunks.back().box, it.box);
     rs.chunks.back().end = i + 1;
+  }
+  // The angular index pays where the segments wind about o in a ring thinner than the
+  // tool (a helix turn); a raster pass's edges go through the chunks only.
+  f.angular = rs.items.size() >= kChunk && f.rho_max - f.rho_min < f.r_max;
+  if (!f.angular) return true;
+  for (std::uint32_t i = 0; i < rs.items.size(); ++i) {
+    ReachScratch::Item& it = rs.items[i];
+    const ReachCapsule& c = rs.caps[it.k];
+    const V2 a{c.ax, c.ay}, b{c.bx, c.by};
+    double span = kPeriod;  // (a segment through the centre's unit disk is wide)
+    if (dist2_point_segment(o, a, b) >= 1.0) interval_of_segment(a, b, o, it.lo, span);
+    it.wide = span > kNarrowRad;
+    (it.wide ? rs.wide : rs.sorted).push_back(i);
   }
   std::sort(rs.sorted.begin(), rs.sorted.end(), [&](std::uint32_t x, std::uint32_t y) {
     return rs.items[x].lo < rs.items[y].lo || (rs.items[x].lo == rs.items[y].lo && x < y);
   });
   return true;
+}
+
+bool capsule_meets(const ReachCapsule& c, const ReachScratch::Box& b) noexcept {
+  return c.r > 0.0 && std::min(c.ax, c.bx) - c.r <= b.x1 && std::max(c.ax, c.bx) + c.r >= b.x0 &&
+         std::min(c.ay, c.by) - c.r <= b.y1 && std::max(c.ay, c.by) + c.r >= b.y0;
 }
 
 bool edge_hits(const ReachScratch& rs, std::uint32_t i, V2 u, V2 v) noexcept {
@@ -180,7 +193,7 @@ bool scan_chunks(const ReachScratch& rs, V2 u, V2 v) noexcept {
   for (const ReachScratch::Chunk& ch : rs.chunks) {
     if (box_misses(ch.box, u, v)) continue;
     for (std::uint32_t i = ch.begin; i < ch.end; ++i)
-      if (!rs.items[i].wide && edge_hits(rs, i, u, v)) return true;
+      if (!rs.items[i].wide && edge_hits(rs, i, u, v)) return true;  // (wide ones: none without the index)
   }
   return false;
 }
@@ -212,6 +225,7 @@ bool edge_in_reach(const ReachScratch& rs, const ReachFrame& f, V2 u, V2 v) noex
   if (d >= f.rho_max + f.r_max) return false;
   const double d_max = std::sqrt(std::max(dist2_point_segment(u, o, o), dist2_point_segment(v, o, o)));
   if (d_max <= f.rho_min - f.r_max) return false;
+  if (!f.angular) return scan_chunks(rs, u, v);
   for (std::uint32_t i : rs.wide)
     if (edge_hits(rs, i, u, v)) return true;
   const double w = window_rad(f, d, d_max);
@@ -285,10 +299,19 @@ void add_section_reach(const Path& p, double ax_mm, double ay_mm, double bx_mm, 
 
 bool material_out_of_reach(const Cell& cell, std::span<const std::uint32_t> touched, const LevelSections& ls,
                            std::span<const std::uint32_t> selected, ReachScratch& rs) {
+  // Only capsules whose box meets the touched polygons' box can hold their material; a long
+  // pass's outline brings the capsules of all its moves.
+  ReachScratch::Box material;
+  for (std::uint32_t t : touched) {
+    const Rect& b = cell.polys[t].bbox;
+    grow(material, ReachScratch::Box{static_cast<double>(b.x0), static_cast<double>(b.y0), static_cast<double>(b.x1),
+                                     static_cast<double>(b.y1)});
+  }
   rs.caps.clear();
   for (std::uint32_t s : selected) {
     if (s >= ls.reach_begin.size() || ls.reach_begin[s] == kNoReach) return false;
-    rs.caps.insert(rs.caps.end(), ls.reach.begin() + ls.reach_begin[s], ls.reach.begin() + ls.reach_end[s]);
+    for (std::uint32_t k = ls.reach_begin[s]; k < ls.reach_end[s]; ++k)
+      if (capsule_meets(ls.reach[k], material)) rs.caps.push_back(ls.reach[k]);
   }
   // A segment's end inside the material is in reach (cheap, and where a clip does cut it
   // usually answers first). Once no material edge meets a capsule either, each connected

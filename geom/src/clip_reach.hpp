@@ -55,6 +55,7 @@ struct ReachScratch {
   struct Frame {
     double ox = 0, oy = 0, rho_max = 0, rho_min = 0, r_max = 0;
     Box all;
+    bool angular = false;  // items carry lo/wide and `sorted`, `wide` are built
   };
   Frame frame;
   std::vector<ReachCapsule> framed;  // the capsules that items, chunks and frame describe
