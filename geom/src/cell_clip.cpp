@@ -3,6 +3,7 @@
 // chain offsets cut down to the region, one Clipper difference, move ids carried over.
 #include <algorithm>
 
+#include "clip_reach.hpp"
 #include "polygon_ops.hpp"
 #include "subtract_engine.hpp"
 
@@ -165,6 +166,10 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
   if (!cell.bbox.intersects(ls.all)) return false;
   ++stats.cells_tested;
   if (!select_for_cell(cell, ls, ws) || !drop_sections_in_air(cell, ls, ws, stats)) return false;
+  if (material_out_of_reach(cell, ws.touched, ls, ws.selected, ws.reach)) {
+    ++stats.cells_out_of_reach;
+    return false;
+  }
 
   ClipperLib::Clipper& c = ws.clipper;
   c.Clear();

@@ -31,6 +31,17 @@ void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
   co.Execute(off.paths, (sh.offset_keys[o].r + 0.25 * tol) * kUnitsPerMm);
 }
 
+namespace {
+// Section k's capsules start at the end of ls.reach; the sections before it that have none
+// (tilted) are marked so.
+void begin_reach(LevelSections& ls, std::size_t k) {
+  ls.reach_begin.resize(k, kNoReach);
+  ls.reach_end.resize(k, kNoReach);
+  ls.reach_begin.push_back(static_cast<std::uint32_t>(ls.reach.size()));
+  ls.reach_end.push_back(kNoReach);
+}
+}  // namespace
+
 void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                                  SubtractStats& stats) const {
   const double zc = s_.level_z_mm(level);
@@ -41,6 +52,9 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
   ls.id.clear();
   ls.chain.clear();
   ls.chain_offset.assign(sh.chain_count, kNoChain);
+  ls.reach.clear();
+  ls.reach_begin.clear();
+  ls.reach_end.clear();
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
@@ -50,6 +64,8 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
   for (int r = 0; r < s_.regions(); ++r) material.add(s_.cell(r, level).bbox);
   for (const auto& run : sh.runs) build_run_sections(zc, run, material, sh, ws, ls, stats);
   ls.chain.assign(ls.paths.size(), kNoChain);
+  ls.reach_begin.resize(ls.paths.size(), kNoReach);  // tilted sections: none
+  ls.reach_end.resize(ls.paths.size(), kNoReach);
   add_chain_sections(level, sh, ls);
   add_lathe_sections(zc, sh, ls);
   stats.sections += ls.paths.size();
@@ -116,6 +132,7 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
                                         const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                                         SubtractStats& stats) const {
   Capsule prev_core;  // inside the last single vertical section of this run (trim_covered())
+  const double band = reach_band_units(s_.spec_.chord_tol_mm);
   auto push_boxes = [&](std::size_t before, MoveId id) {
     for (std::size_t k = before; k < ls.paths.size(); ++k) {
       ls.box.push_back(bounds_of(ls.paths[k]));
@@ -162,6 +179,11 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
         MoveId id = 0;
         for (std::size_t k = 0; k < count; ++k) id = std::max(id, sh.sweep_id[si + k]);
         push_boxes(before, id);
+        if (ls.paths.size() == before + 1) {
+          begin_reach(ls, before);
+          add_outline_reach(std::span<const MoveCaps>(ws.caps.data(), count), band, ls.reach);
+          ls.reach_end[before] = static_cast<std::uint32_t>(ls.reach.size());
+        }
         stats.sections_joined += count;
         prev_core = Capsule{};
         si += static_cast<std::uint32_t>(count);
@@ -185,6 +207,11 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
       if (ws.scratch.core.valid()) prev_core = ws.scratch.core;
     }
     push_boxes(before, sh.sweep_id[si]);
+    for (std::size_t k = before; k < ls.paths.size(); ++k) {
+      begin_reach(ls, k);
+      add_section_reach(ls.paths[k], sw.from().tip.x, sw.from().tip.y, sw.to().tip.x, sw.to().tip.y, band, ls.reach);
+      ls.reach_end[k] = static_cast<std::uint32_t>(ls.reach.size());
+    }
     ++si;
   }
   flush_tilted();

@@ -9,11 +9,13 @@
 #include <utility>
 #include <vector>
 
+#include "clip_reach.hpp"
 #include "geom/lbr_solid.hpp"
 
 namespace lbr::geom::detail {
 
 inline constexpr std::uint32_t kNoChain = 0xFFFFFFFFu;
+inline constexpr std::uint32_t kNoReach = 0xFFFFFFFFu;  // a section without capsules (LevelSections::reach_begin)
 
 // One step of a thread's wait for another's (a few microseconds at most).
 inline void cpu_relax() noexcept {
@@ -33,6 +35,10 @@ struct LevelSections {
   int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // regions that the boxes reach
   std::vector<std::uint8_t> same_cell_below;  // per region: same start as the level below
   std::vector<std::uint32_t> cost;            // per region: the cell's vertices before the batch
+  // Per section: its capsules [reach_begin, reach_end) in `reach` (clip_reach.hpp), or
+  // reach_begin = kNoReach (chain offsets, tilted and lathe sections).
+  std::vector<ReachCapsule> reach;
+  std::vector<std::uint32_t> reach_begin, reach_end;
   [[nodiscard]] bool empty() const noexcept { return ix1 < ix0 || iy1 < iy0; }
 };
 
@@ -120,6 +126,7 @@ struct SubtractWorkspace {
   SubtractShared own;               // for a subtraction on one thread
   std::vector<std::uint32_t> selected, touched;
   std::vector<Polygon> fresh, kept;
+  ReachScratch reach;               // material_out_of_reach()
 };
 
 }  // namespace lbr::geom::detail

@@ -113,12 +113,14 @@ struct SubtractStats {
   std::uint64_t chain_offsets = 0;     // chain offsets built (ParallelSubtractor::run(): some for the next batch)
   std::uint64_t sections_joined = 0;   // move sections written as part of a joined outline
   std::uint64_t outlines_star = 0;     // joined outlines of tight loops written as their outer chain only
+  std::uint64_t cells_out_of_reach = 0;  // clips left out: no material within the sections' reach
   SubtractStats& operator+=(const SubtractStats& o) noexcept {
     sections += o.sections; cells_tested += o.cells_tested;
     cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
     sections_trimmed += o.sections_trimmed; cells_reused += o.cells_reused;
     sections_in_air += o.sections_in_air; chain_offsets += o.chain_offsets;
     sections_joined += o.sections_joined; outlines_star += o.outlines_star;
+    cells_out_of_reach += o.cells_out_of_reach;
     return *this;
   }
 };
