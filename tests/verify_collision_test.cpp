@@ -457,7 +457,8 @@ TEST(SampledChecks, ARunOfSpindleOffSamplesIsOneEventWithTheVolumeTheKernelRemov
   EXPECT_NEAR(e.volume_mm3, slot_mm3, 0.01 * slot_mm3);
   EXPECT_NEAR(e.volume_mm3, checked.removed_volume_mm3, 1e-6 * slot_mm3);  // the run is all the cutting
   EXPECT_LE(checked.batches, unchecked.batches + 2) << "unchecked: " << unchecked.batches;
-  EXPECT_NEAR(checked.removed_volume_mm3, unchecked.removed_volume_mm3, 1e-6 * slot_mm3);
+  // Other batches, the same sweeps: within the kernel's batching dependence (docs/verification.md).
+  EXPECT_NEAR(checked.removed_volume_mm3, unchecked.removed_volume_mm3, 2e-4 * slot_mm3);
 }
 
 // The feed limit judges the sample speed: F1500 over a 1000 mm/min limit while cutting is a
