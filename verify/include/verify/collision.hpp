@@ -90,7 +90,7 @@ class MoveIndex {
 class CollisionChecker {
  public:
   // Builds the shank and holder shapes of every milling tool of `tools` (which must outlive
-  // the checker).
+  // the checker) and the holders of its turning tools that have one.
   CollisionChecker(const CheckConfig& config, const motion::ToolTable& tools, const MoveIndex& index);
 
   // Checks moves [from, to) against `solid`, the stock just before moves[from]. Returns the
