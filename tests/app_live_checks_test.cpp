@@ -19,25 +19,25 @@ namespace {
 
 using namespace lbr;
 
-hal::AxisSample sample(std::uint64_t seq, double x, double y, double z) {
+hal::AxisSample sample(std::uint64_t seq, double x, double y, double z, int tool = 1) {
   hal::AxisSample s;
   s.seq = seq;
   s.t_rx_ns = static_cast<std::int64_t>(seq) * 1'000'000;
   s.mask = 0x3F;
-  s.tool = 1;
+  s.tool = static_cast<decltype(s.tool)>(tool);
   s.q = {x, y, z, 0, 0, 0};
   return s;
 }
 
 struct Rig {
-  app::Profile profile = app::default_profile();
+  app::Profile profile;
   geom::LbrSolid solid{profile.solid};
   motion::ToolTable tools{profile.tooling, profile.solid.chord_tol_mm, profile.source};
   sched::SpscRing<hal::AxisSample> ring{4096};
   std::unique_ptr<app::live::Geometry> geo;
   std::unique_ptr<app::live::LiveChecks> checks;
   std::uint64_t seq = 1;
-  Rig() {
+  explicit Rig(app::Profile p = app::default_profile()) : profile(std::move(p)) {
     tools.build_all();
     geo = std::make_unique<app::live::Geometry>(solid, profile, tools, 1, ring, 0.001);
     checks = std::make_unique<app::live::LiveChecks>(profile, tools, app::live::Geometry::batch_capacity(4096),
@@ -123,6 +123,49 @@ TEST(LiveChecks, ChecksInTheAirDoNotAllocate) {
   (void)rig.pass(10.0, 22.0, 5.0, 200, 0.1);
   (void)rig.pass(10.0, 23.0, 5.0, 40, 2.0);
   EXPECT_EQ(test::allocations() - before, 0) << "checking sweeps that miss the stock allocated";
+}
+
+// A lathe (docs/verification.md#turning): D40 bar, Z-80..0; T4 a sharp grooving blade 3 wide
+// and 10 deep with a holder 13 wide from 5 mm on the chuck side, from the blade's depth out.
+app::Profile live_lathe() {
+  return app::parse_profile(
+      "[machine]\nkind = \"lathe\"\n[stock]\nshape = \"cylinder\"\ncenter_mm = [0.0, 0.0]\ndiameter_mm = 40.0\n"
+      "z_min_mm = -80.0\nz_max_mm = 0.0\n[lbr]\nlevel_spacing_mm = 0.1\nregions = \"2x2\"\nlive_regions = \"2x2\"\n"
+      "[[tool]]\nnumber = 4\nkind = \"grooving\"\nwidth_mm = 3.0\nnose_radius_mm = 0.0\ndepth_mm = 10.0\n"
+      "holder_width_mm = 13.0\nholder_z_mm = -5.0\nholder_r_mm = 10.0\n",
+      "lathe-live.toml");
+}
+
+TEST(LiveChecks, AFastGrooveIntoTheBarIsARapidWithTheBladesVolume) {
+  Rig rig(live_lathe());
+  // The blade at Z-10 from r 25 to r 15, 0.5 mm a sample (30 m/min): the ring 15..20 x 3.
+  for (int i = 0; i <= 20; ++i) (void)rig.ring.try_push(sample(rig.seq++, 25.0 - 0.5 * i, 0.0, -10.0, 4));
+  (void)rig.geo->tick(4096);
+  const std::vector<verify::Event> ev = rig.checks->events();
+  ASSERT_EQ(ev.size(), 1u) << verify::describe(ev.at(1));
+  EXPECT_EQ(ev[0].kind, verify::EventKind::RapidIntoMaterial);
+  EXPECT_EQ(ev[0].tool, 4);
+  const double expected = std::numbers::pi * (400.0 - 225.0) * 3.0;
+  EXPECT_NEAR(ev[0].volume_mm3, expected, 0.01 * expected);
+  EXPECT_NEAR(rig.solid.initial_volume_mm3() - rig.solid.volume_mm3(), expected, 0.01 * expected);
+}
+
+TEST(LiveChecks, AGrooveDeeperThanTheBladeDrivesTheHolderIn) {
+  Rig rig(live_lathe());
+  // At feed speed (0.05 mm a sample = 3 m/min) to r 5 at Z-30: the holder reaches r 15 on
+  // the 10 mm of its width beside the blade.
+  for (int i = 0; i <= 400; ++i) (void)rig.ring.try_push(sample(rig.seq++, 25.0 - 0.05 * i, 0.0, -30.0, 4));
+  (void)rig.geo->tick(4096);
+  const std::vector<verify::Event> ev = rig.checks->events();
+  ASSERT_FALSE(ev.empty());
+  for (const verify::Event& e : ev) EXPECT_EQ(e.kind, verify::EventKind::HolderInMaterial) << verify::describe(e);
+  EXPECT_EQ(ev[0].tool, 4);
+  EXPECT_GT(ev[0].volume_mm3, 0.0);
+  // Stopping at r 11 (the holder at r 21) is clean.
+  Rig clean(live_lathe());
+  for (int i = 0; i <= 280; ++i) (void)clean.ring.try_push(sample(clean.seq++, 25.0 - 0.05 * i, 0.0, -30.0, 4));
+  (void)clean.geo->tick(4096);
+  EXPECT_TRUE(clean.checks->events().empty()) << verify::describe(clean.checks->events().at(0));
 }
 
 }  // namespace

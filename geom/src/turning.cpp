@@ -68,6 +68,9 @@ bool parse_insert_kind(const std::string& s, InsertKind& out) noexcept {
 std::string TurningTool::validate() const {
   if (!(nose_radius_mm >= 0.0 && nose_radius_mm <= 10.0)) return "nose_radius_mm must be in [0, 10]";
   if (!(edge_length_mm > 0.0 && edge_length_mm <= 1000.0)) return "edge_length_mm must be in (0, 1000]";
+  if (!(holder_width_mm >= 0.0 && holder_width_mm <= 1000.0)) return "holder_width_mm must be in [0, 1000]";
+  if (!(holder_r_mm >= 0.0 && holder_r_mm <= 1000.0)) return "holder_r_mm must be in [0, 1000]";
+  if (!(std::abs(holder_z_mm) <= 1000.0)) return "holder_z_mm must be in [-1000, 1000]";
   if (insert == InsertKind::Groove) {
     if (!(width_mm > 0.0 && width_mm <= 100.0)) return "width_mm must be in (0, 100]";
     if (2.0 * nose_radius_mm > width_mm) return "nose_radius_mm must be at most width_mm / 2";
@@ -131,6 +134,24 @@ TurningShape TurningShape::build(const TurningTool& tool, double chord_tol_mm) {
   return s;
 }
 
+TurningShape TurningShape::holder(const TurningTool& tool, double chord_tol_mm) {
+  constexpr double kReach = 1000.0;  // out of any stock [mm]; only the side towards the cut matters
+  TurningShape s;
+  s.tool = tool;
+  s.chord_tol_mm = chord_tol_mm;
+  const double w = tool.holder_width_mm;
+  if (tool.internal)
+    s.pts = {{0.0, 0.0}, {0.0, w}, {-kReach, w}, {-kReach, 0.0}};
+  else
+    s.pts = {{0.0, 0.0}, {kReach, 0.0}, {kReach, w}, {0.0, w}};
+  s.z_extent = w;
+  return s;
+}
+
+TurningShape::P2 TurningShape::holder_offset(const TurningTool& tool) noexcept {
+  return {tool.internal ? -tool.holder_r_mm : tool.holder_r_mm, tool.holder_z_mm};
+}
+
 LatheSweep::LatheSweep(const TurningShape& shape, double r0_mm, double z0_mm, double r1_mm, double z1_mm) noexcept
     : shape_(&shape), r0_(r0_mm), z0_(z0_mm), dr_(r1_mm - r0_mm), dz_(z1_mm - z0_mm) {
   zlo_ = std::min(z0_mm, z1_mm);
@@ -179,33 +200,43 @@ std::size_t LatheSweep::section(double z, const Rect& extent, Paths& out) const 
 }
 
 std::size_t LatheSweep::removed_region(double r, bool inside, double tol, const Rect& extent, Paths& out) {
-  if (extent.empty()) return 0;
-  auto circle = [&](double rad, bool ccw) {
-    const int n = Sweep::circle_segments(rad, tol);
-    const double rho = rad * 2.0 / (1.0 + std::cos(std::numbers::pi / n));
-    Path c;
-    c.reserve(static_cast<std::size_t>(n));
-    for (int k = 0; k < n; ++k) {
-      const double a = 2.0 * std::numbers::pi * (ccw ? k : n - k) / n;
-      c.push_back({to_units(rho * std::cos(a)), to_units(rho * std::sin(a))});
-    }
-    out.push_back(std::move(c));
-  };
-  if (inside) {
-    if (r <= 0.0) return 0;
-    circle(r, true);
-    return 1;
+  return inside ? ring(0.0, r, tol, extent, out) : ring(r, INFINITY, tol, extent, out);
+}
+
+namespace {
+// A circle polygonised like a tool section (vertices at rho = 2r / (1 + cos(pi / n))).
+void append_circle(double rad, bool ccw, double tol, Paths& out) {
+  const int n = Sweep::circle_segments(rad, tol);
+  const double rho = rad * 2.0 / (1.0 + std::cos(std::numbers::pi / n));
+  Path c;
+  c.reserve(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    const double a = 2.0 * std::numbers::pi * (ccw ? k : n - k) / n;
+    c.push_back({to_units(rho * std::cos(a)), to_units(rho * std::sin(a))});
   }
-  // Nothing to remove when the circle holds the whole extent.
-  const double fx = std::max(std::abs(to_mm(extent.x0)), std::abs(to_mm(extent.x1)));
-  const double fy = std::max(std::abs(to_mm(extent.y0)), std::abs(to_mm(extent.y1)));
-  if (r * r >= fx * fx + fy * fy) return 0;
-  const Coord m = 16;  // margin [units] so the square strictly covers the extent
-  out.push_back(Path{{extent.x0 - m, extent.y0 - m}, {extent.x1 + m, extent.y0 - m}, {extent.x1 + m, extent.y1 + m},
-                     {extent.x0 - m, extent.y1 + m}});
-  if (r <= 0.0) return 1;
-  circle(r, false);
-  return 2;
+  out.push_back(std::move(c));
+}
+}  // namespace
+
+std::size_t LatheSweep::ring(double r_in, double r_out, double tol, const Rect& extent, Paths& out) {
+  if (extent.empty() || !(r_out > std::max(r_in, 0.0))) return 0;
+  std::size_t n = 0;
+  if (std::isfinite(r_out)) {
+    append_circle(r_out, true, tol, out);
+    ++n;
+  } else {
+    // Nothing to remove when the circle holds the whole extent.
+    const double fx = std::max(std::abs(to_mm(extent.x0)), std::abs(to_mm(extent.x1)));
+    const double fy = std::max(std::abs(to_mm(extent.y0)), std::abs(to_mm(extent.y1)));
+    if (r_in > 0.0 && r_in * r_in >= fx * fx + fy * fy) return 0;
+    const Coord m = 16;  // margin [units] so the square strictly covers the extent
+    out.push_back(Path{{extent.x0 - m, extent.y0 - m}, {extent.x1 + m, extent.y0 - m}, {extent.x1 + m, extent.y1 + m},
+                       {extent.x0 - m, extent.y1 + m}});
+    ++n;
+  }
+  if (r_in <= 0.0) return n;
+  append_circle(r_in, false, tol, out);
+  return n + 1;
 }
 
 }  // namespace lbr::geom

@@ -33,6 +33,9 @@ geom::TurningTool read_insert(cfg::Table& s, const std::string& kind) {
     t.edge_length_mm = s.number("edge_length_mm", 12.0, 0.01, 1000.0, "mm");
     t.approach_deg = s.number("approach_angle_deg", t.insert == geom::InsertKind::Diamond80 ? 95.0 : 93.0, 0.0, 180.0, "deg");
   }
+  t.holder_width_mm = s.number("holder_width_mm", 0.0, 0.0, 1000.0, "mm");
+  t.holder_z_mm = s.number("holder_z_mm", 0.0, -1000.0, 1000.0, "mm");
+  t.holder_r_mm = s.number("holder_r_mm", 0.0, 0.0, 1000.0, "mm");
   if (const std::string e = t.validate(); !e.empty()) fail_validation(s, e, t.insert == geom::InsertKind::Groove);
   return t;
 }

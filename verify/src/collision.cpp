@@ -48,6 +48,12 @@ double descent_deg(const geom::Pose& from, const geom::Pose& to) {
   return std::atan2(-along, across) * 180.0 / std::numbers::pi;
 }
 
+// A turning move as the kernel sweeps it (geom/src/batch_plan.cpp): the reference point from
+// (from.tip.x, from.tip.z) to (to.tip.x, to.tip.z) in the (r, z) plane, moved by `offset`.
+geom::LatheSweep lathe_sweep(const geom::TurningShape& shape, const geom::SweepRef& r, geom::TurningShape::P2 offset) {
+  return {shape, r.from.tip.x + offset.r, r.from.tip.z + offset.z, r.to.tip.x + offset.r, r.to.tip.z + offset.z};
+}
+
 }  // namespace
 
 void MoveIndex::add(const nc::Toolpath& path, geom::MoveId base) {
@@ -86,10 +92,24 @@ CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::Tool
       p.core = cylinder(kNonCuttingCoreFraction * tool.diameter_mm, tool.flute_length_mm, tools.chord_tol_mm());
     parts_.emplace(number, std::move(p));
   }
+  // A holder's faces along Z stand back by the tolerance, as a milling holder's face does.
+  for (const auto& [number, insert] : tools.config().inserts) {
+    if (!(insert.holder_width_mm > 2.0 * config.tolerance_mm)) continue;
+    geom::TurningTool t = insert;
+    t.holder_width_mm -= 2.0 * config.tolerance_mm;
+    t.holder_z_mm += config.tolerance_mm;
+    holders_.emplace(number, InsertHolder{geom::TurningShape::holder(t, tools.chord_tol_mm()),
+                                          geom::TurningShape::holder_offset(t)});
+  }
 }
 
 int CollisionChecker::findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, int rapid, Findings& out) {
-  if (m.ref.shape == nullptr) return 0;  // turning inserts and tool 0: not checked
+  if (m.ref.turning != nullptr) {
+    const int n = segment_findings(solid, m, index_.find(m.ref.id, nullptr), rapid, out, 0);
+    const auto h = holders_.find(m.tool);
+    return h != holders_.end() ? holder_finding(solid, m, h->second, out, n) : n;
+  }
+  if (m.ref.shape == nullptr) return 0;  // tool 0: nothing cuts
   const auto parts = parts_.find(m.tool);
   const Parts* p = parts == parts_.end() ? nullptr : &parts->second;
   const int n = segment_findings(solid, m, index_.find(m.ref.id, nullptr), rapid, out, 0);
@@ -105,14 +125,28 @@ int CollisionChecker::segment_findings(const geom::LbrSolid& solid, const motion
   const bool too_fast = !rapid && seg != nullptr && seg->kind == nc::SegmentKind::Feed && feed_limit > 0.0 &&
                         seg->feed_mm_per_min > feed_limit;
   if (rapid || spindle_off || too_fast) {
-    const Intrusion in =
-        probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm, contact_only_);
+    const Intrusion in = cutting_intrusion(solid, m);
     if (in.deep_mm3 > 0.0) {
       if (rapid) out[n++] = {EventKind::RapidIntoMaterial, in};
       if (spindle_off) out[n++] = {EventKind::SpindleOff, in, seg->spindle_s};
       if (too_fast) out[n++] = {EventKind::FeedLimit, in, seg->feed_mm_per_min};
     }
   }
+  return n;
+}
+
+Intrusion CollisionChecker::cutting_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m) {
+  if (m.ref.turning != nullptr)
+    return probe_.measure(solid, lathe_sweep(*m.ref.turning, m.ref, {0.0, 0.0}), config_.tolerance_mm, contact_only_);
+  return probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm, contact_only_);
+}
+
+int CollisionChecker::holder_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, const InsertHolder& h,
+                                     Findings& out, int n) {
+  const geom::LatheSweep insert = lathe_sweep(*m.ref.turning, m.ref, {0.0, 0.0});
+  const Intrusion in =
+      probe_.measure(solid, lathe_sweep(h.shape, m.ref, h.offset), config_.tolerance_mm, contact_only_, &insert);
+  if (in.deep_mm3 > 0.0) out[n++] = {EventKind::HolderInMaterial, in};
   return n;
 }
 

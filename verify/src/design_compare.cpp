@@ -240,12 +240,21 @@ void attribute_gouge(DesignReport& report, const geom::LbrSolid& solid, std::spa
   const geom::Point p{geom::to_units(report.gouge_probe.x), geom::to_units(report.gouge_probe.y)};
   geom::SectionScratch scratch;
   geom::Paths section;
+  // A turning move removes its insert's revolved region: the point's radius against the
+  // region's radius on the level (exact; the kernel's circles lie within tol/2 of it).
+  const double r_probe = std::hypot(report.gouge_probe.x, report.gouge_probe.y);
   for (const motion::TimedSweep& m : moves) {
-    if (m.ref.shape == nullptr || m.ref.turning != nullptr) continue;
-    section.clear();
-    geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to).section(z, section, scratch);
-    const bool inside = std::any_of(section.begin(), section.end(),
-                                    [&](const geom::Path& s) { return ClipperLib::PointInPolygon(p, s) != 0; });
+    bool inside = false;
+    if (m.ref.turning != nullptr) {
+      const geom::LatheSweep lathe(*m.ref.turning, m.ref.from.tip.x, m.ref.from.tip.z, m.ref.to.tip.x, m.ref.to.tip.z);
+      double lo = 0.0, hi = 0.0;
+      inside = lathe.interval(z, lo, hi) && (lathe.internal() ? r_probe <= hi : r_probe >= lo);
+    } else if (m.ref.shape != nullptr) {
+      section.clear();
+      geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to).section(z, section, scratch);
+      inside = std::any_of(section.begin(), section.end(),
+                           [&](const geom::Path& s) { return ClipperLib::PointInPolygon(p, s) != 0; });
+    }
     if (!inside) continue;
     report.gouge_move = m.ref.id;
     report.gouge_tool = m.tool;

@@ -45,6 +45,14 @@ struct TurningTool {
   // clearance. The nose angle plus approach - 90 must not exceed 90 (the trailing edge
   // must not face -r). Rhombus inserts only.
   double approach_deg = 95.0;
+  // The holder (shank, blade holder or boring bar; collision checks only, never cuts): in
+  // the (r, z) plane a bar from `holder_z_mm` to `holder_z_mm + holder_width_mm` along +Z
+  // from the reference point, and from `holder_r_mm` outwards from it (internal tools: from
+  // `holder_r_mm` inwards, towards the axis), reaching out of the stock as the insert's own
+  // region does. holder_width_mm 0: no holder (docs/verification.md).
+  double holder_width_mm = 0.0;
+  double holder_z_mm = 0.0;
+  double holder_r_mm = 0.0;
 
   // "" when valid, else what is wrong.
   [[nodiscard]] std::string validate() const;
@@ -63,6 +71,13 @@ struct TurningShape {
   double z_extent = 0.0;  // height of the insert along Z [mm]
 
   static TurningShape build(const TurningTool& tool, double chord_tol_mm);
+  // The holder of `tool` (tool.holder_width_mm > 0) as a shape of its own: a rectangle
+  // holder_width_mm along Z that reaches 1 m out (in, internal tools) from its reference
+  // point, the holder's corner nearest the insert's reference point. Sweep it with
+  // LatheSweep from the insert's reference point moved by holder_offset(). Allocates.
+  static TurningShape holder(const TurningTool& tool, double chord_tol_mm);
+  // (dr, dz) from the insert's reference point to the holder's [mm].
+  [[nodiscard]] static P2 holder_offset(const TurningTool& tool) noexcept;
 };
 
 // A turning move: the insert reference point goes from (r0, z0) to (r1, z1) in the (r, z)
@@ -89,6 +104,12 @@ class LatheSweep {
   // (r_max). Used to emit one region for many turning moves on a level: the union of
   // {r >= r_i} is {r >= min r_i}, of {r <= r_i} it is {r <= max r_i}.
   static std::size_t removed_region(double r_mm, bool internal, double chord_tol_mm, const Rect& extent, Paths& out);
+  // The ring {r_in <= r <= r_out} on a level: a counter-clockwise circle of radius r_out (a
+  // square covering `extent` when r_out is infinite) with a clockwise circle of radius r_in
+  // as a hole (none when r_in <= 0); nothing when the ring is empty or, r_out infinite, the
+  // hole holds the whole extent. removed_region() is ring(r, inf) (external) or ring(0, r)
+  // (internal). Circles as in section(). Returns the number of paths appended.
+  static std::size_t ring(double r_in_mm, double r_out_mm, double chord_tol_mm, const Rect& extent, Paths& out);
   [[nodiscard]] double chord_tol_mm() const noexcept { return shape_->chord_tol_mm; }
 
  private:

@@ -8,7 +8,9 @@
 // (spindle-nose-in-material, [checks] spindle_nose_*); a cutting sweep that removes material
 // while the segment's spindle is off (spindle-off) or faster than the feed limit
 // (feed-limit); the centre core of a non-centre-cutting tool meeting material on a descent
-// steeper than the ramp limit (plunge-non-centre-cutting). Turning inserts are not checked.
+// steeper than the ramp limit (plunge-non-centre-cutting). Turning moves (geom::LatheSweep)
+// go through the same checks of the cutting sweep (rapid, spindle off, feed limit) and
+// their holder ([[tool]] holder_width_mm …) through holder-in-material.
 // check_travel() checks a tool path's axis positions against the machine's travel.
 //
 // The batch runner asks `check()` before subtracting a batch of moves. The stock before the
@@ -89,7 +91,7 @@ class MoveIndex {
 class CollisionChecker {
  public:
   // Builds the shank and holder shapes of every milling tool of `tools` (which must outlive
-  // the checker).
+  // the checker) and the holders of its turning tools that have one.
   CollisionChecker(const CheckConfig& config, const motion::ToolTable& tools, const MoveIndex& index);
 
   // Checks moves [from, to) against `solid`, the stock just before moves[from]. Returns the
@@ -132,6 +134,11 @@ class CollisionChecker {
     bool has_nose = false;        // [checks] spindle_nose_diameter_mm set
     bool centre_cutting = true;   // false: `core` is the end face's non-cutting centre
   };
+  // A turning tool's holder: its shape and where it sits from the insert's reference point.
+  struct InsertHolder {
+    geom::TurningShape shape;
+    geom::TurningShape::P2 offset{0.0, 0.0};  // holder reference - insert reference (r, z) [mm]
+  };
   struct Finding {
     EventKind kind;
     Intrusion what;
@@ -156,6 +163,11 @@ class CollisionChecker {
   // new count.
   int segment_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const nc::Segment* seg, int rapid,
                        Findings& out, int n);
+  // The material a move's cutting sweep (milling or turning) meets.
+  [[nodiscard]] Intrusion cutting_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m);
+  // A turning move's holder, written to out[n]; returns the new count.
+  int holder_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, const InsertHolder& h, Findings& out,
+                     int n);
   // Plunge (the non-cutting core), shank, holder and spindle nose, written from out[n];
   // returns the new count.
   int part_findings(const geom::LbrSolid& solid, const motion::TimedSweep& m, const Parts& p, Findings& out, int n);
@@ -167,6 +179,7 @@ class CollisionChecker {
   CheckConfig config_;
   const MoveIndex& index_;
   std::map<int, Parts> parts_;
+  std::map<int, InsertHolder> holders_;  // turning tools with a holder
   IntrusionProbe probe_;
 };
 

@@ -69,7 +69,8 @@ struct DesignReport {
                                           double tolerance_mm);
 
 // Sets gouge_move / gouge_source / gouge_line: the earliest of `moves` (in cutting order)
-// whose section on the level of the deepest gouge contains a point just inside that gouge.
+// whose section on the level of the deepest gouge contains a point just inside that gouge
+// (a turning move: whose revolved region there, {r >= r_min} or {r <= r_max}, holds it).
 void attribute_gouge(DesignReport& report, const geom::LbrSolid& solid, std::span<const motion::TimedSweep> moves,
                      const MoveIndex& index);
 

@@ -5,13 +5,20 @@
 // Clipper intersection per touched cell), so the volume is what LbrSolid::subtract() would
 // remove with that sweep: exact up to the level discretisation and the chord tolerance.
 //
+// Turning sweeps (geom::LatheSweep) are measured the same way, with the region the kernel
+// removes on each level: {r >= r_min} (external tools) or {r <= r_max} (internal).
+//
 // Not real-time: allocates (Clipper, growing buffers); read-only on the solid.
 #pragma once
 
 #include <clipper.hpp>
 
+#include <cstdint>
+#include <vector>
+
 #include "geom/lbr_solid.hpp"
 #include "geom/sweep.hpp"
+#include "geom/turning.hpp"
 
 namespace lbr::verify {
 
@@ -33,8 +40,38 @@ class IntrusionProbe {
   // contact: deep_mm3 > 0 tells the same, volume_mm3 and depth_mm are those levels' only.
   [[nodiscard]] Intrusion measure(const geom::LbrSolid& solid, const geom::Sweep& sweep, double margin_mm,
                                   bool contact_only = false);
+  // The same for a turning sweep: the material inside its revolved region on each level.
+  // With `shadow` (the same move's insert, when `sweep` is its holder) only the material
+  // the shadow does not remove on that level counts: the insert leads its holder, so what
+  // they both reach is cut before the holder gets there (docs/verification.md#turning).
+  // deep_mm3 counts the material farther than `margin_mm` inside the region's circles.
+  [[nodiscard]] Intrusion measure(const geom::LbrSolid& solid, const geom::LatheSweep& sweep, double margin_mm,
+                                  bool contact_only = false, const geom::LatheSweep* shadow = nullptr);
 
  private:
+  struct Source;  // the sweep the sections come from (intrusion.cpp)
+  [[nodiscard]] Intrusion measure_source(const geom::LbrSolid& solid, const Source& src, double margin_mm,
+                                         bool contact_only);
+  // section_ = the source's section on plane z; false when it has none. A turning source
+  // sets ring_in_ / ring_out_ and meets_[k] (whether region regions_[k]'s cell may meet the
+  // ring) first, and builds no polygon when no cell may meet it.
+  bool source_section(const geom::LbrSolid& solid, const Source& src, int level, double z_mm);
+  // shrunk_ = the section moved inwards by the margin.
+  void source_shrunk(const Source& src, double margin_mm);
+  // Whether any cell of regions_ on `level` may meet the ring ring_in_ … ring_out_ (fills
+  // meets_): not when its farthest point from the axis stays inside r_in, or its box stays
+  // outside r_out (within the circles' polygonisation, half the chord tolerance).
+  bool ring_meets_cells(const geom::LbrSolid& solid, int level, double chord_tol_mm);
+  // The nearest and farthest distance of a cell's material from the spindle axis [mm],
+  // cached per cell and content (version and area): a turning move's holder is tested on
+  // every level it spans, and the stock changes only where it is cut.
+  struct CellReach {
+    std::uint32_t version = 0;
+    double area_units2 = -1.0;  // < 0: not taken yet
+    double near_mm = 0.0, far_mm = 0.0;
+  };
+  const CellReach& cell_reach(const geom::LbrSolid& solid, int region, int level);
+
   void clip_to_rect(const geom::Path& p, const geom::Rect& r);
   // subject_ = the cell's contours cut to `r`; then the area they share with `clip` [mm2].
   void cell_subject(const geom::Cell& cell, const geom::Rect& r);
@@ -48,6 +85,10 @@ class IntrusionProbe {
   geom::Paths section_, shrunk_, subject_, result_;
   geom::Path tmp_a_, tmp_b_;
   ClipperLib::ClipperOffset offset_;
+  double ring_in_ = 0.0, ring_out_ = 0.0;  // turning sources: the ring of the current level [mm]
+  std::vector<char> meets_;                 // turning sources: per regions_ entry, the cell may meet the ring
+  std::vector<CellReach> reach_;  // per (region, level) of reach_solid_
+  const geom::LbrSolid* reach_solid_ = nullptr;
   std::vector<int> regions_;
   std::vector<double> region_volume_;
   ClipperLib::Clipper clipper_;
