@@ -143,7 +143,8 @@ struct Hull3 {
   // as much in all). The search starts from [t_lo, t_hi] (a neighbouring direction's
   // bracket: the tilt changes little between close directions), widened until it brackets
   // the plane; `t_lo`/`t_hi` return the final bracket. At least `min_steps` + 1 steps: a
-  // wide start bracket can give a first step that happens to move little.
+  // wide start bracket can give a first step that happens to move little. Unless the point
+  // is proven within eps of the boundary first: see `proven` below.
   P2 section_point(double phi, double zc, double eps, double& t_lo, double& t_hi, int min_steps) const noexcept {
     return section_point(std::cos(phi), std::sin(phi), zc, eps, t_lo, t_hi, min_steps);
   }
@@ -165,7 +166,22 @@ struct Hull3 {
     // step is taken whatever min_steps says.
     auto proven = [&](const P2& q) { return upper - (ux * q.x + uy * q.y) <= eps; };
     double tlo = t_lo, thi = t_hi;
-    Vec3 plo = sup(tlo), phi_ = sup(thi);
+    // The middle first, then the end on the other side of the plane: the start bracket is
+    // halved for the same two queries.
+    Vec3 plo, phi_;
+    {
+      const double tm = 0.5 * (tlo + thi);
+      const Vec3 pm = sup(tm);
+      if (pm.z <= zc) {
+        tlo = tm;
+        plo = pm;
+        phi_ = sup(thi);
+      } else {
+        thi = tm;
+        phi_ = pm;
+        plo = sup(tlo);
+      }
+    }
     for (int i = 0; i < 80 && plo.z > zc; ++i) {
       const double w = thi - tlo;
       thi = tlo;
