@@ -68,8 +68,12 @@ app::Profile mill5_profile(const std::string& path) {
 }
 
 // A LinuxCNC sample on the mill5 profile: M428/M429/M430 (that configuration's switchkins
-// remaps; M428 = TCP on) dropped and TCP set, the tilt axis from the program's name, and T1 M6
-// added where the program loads no tool (the impeller).
+// remaps; M428 = TCP on) dropped and TCP set, the tilt axis from the program's name. The
+// programmed point is the tool tip, as on LinuxCNC's simulated machine (its tool table gives
+// T1 length 0, and boat-xyzac and the impeller have no G43): tool 1 is in the spindle from the
+// start and a G43 in front compensates its length, so the shank and holder stay where the
+// program means them (without it the tip runs one tool length, 60 mm, below the program and
+// drags the shank through the stock on every move: docs/performance.md).
 std::optional<Workload> linuxcnc_workload(const LinuxcncSample& s, const std::string& dir, const std::string& mill5) {
   const std::string file = dir + "/" + s.name + ".ngc";
   std::ifstream in(file, std::ios::binary);
@@ -79,13 +83,12 @@ std::optional<Workload> linuxcnc_workload(const LinuxcncSample& s, const std::st
   std::string text = ss.str();
   const bool tcp = text.find("M428") != std::string::npos;
   text = std::regex_replace(text, std::regex("M4(28|29|30)"), "");
-  if (!std::regex_search(text, std::regex("M0?6"))) {
-    const std::size_t at = text.rfind('%', 0) == 0 ? text.find('\n') + 1 : 0;  // after a leading %
-    text.insert(at, "T1 M6\n");
-  }
+  const std::size_t at = text.rfind('%', 0) == 0 ? text.find('\n') + 1 : 0;  // after a leading %
+  text.insert(at, "G43\n");
   Workload w{s.name, mill5_profile(mill5), {}, true, false};
   w.prof.kin.tcp = tcp;
   w.prof.kin.rotary = s.rotary;
+  w.prof.nc.start_tool = 1;
   w.program = nc::interpret_gcode(text, file, app::gcode_options(w.prof));
   return w;
 }

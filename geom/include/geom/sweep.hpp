@@ -57,6 +57,9 @@ struct SectionScratch {
   };
   std::vector<Dir> dirs;
   std::vector<TiltedPiece> pieces;  // a tilted sweep's sub-steps on the plane (section())
+  // Support queries of the tilted sections' refinement (Sweep::build_piece()) so far; the
+  // coarse points' are in TiltedPiece::coarse_queries. A count for tests and profiles.
+  std::uint64_t support_queries = 0;
   // Set by each vertical section: a capsule inside the polygon just emitted (invalid when
   // the last section was empty or came from the general path).
   Capsule core;
@@ -99,6 +102,7 @@ struct TiltedPiece {
   Pose a, b;  // the sub-step's poses
   double zc = 0.0;
   std::uint32_t sweep = 0;  // caller's index of the sweep it belongs to
+  std::uint32_t coarse_queries = 0;  // support queries of its material test and coarse points
   SectionScratch::Dir dirs[kDirs];
   // Q's edges of non-zero length: inside Q by at least `margin` <=> nx·x + ny·y <= c - margin.
   struct Edge {
