@@ -182,7 +182,7 @@ std::size_t LatheSweep::removed_region(double r, bool inside, double tol, const 
   if (extent.empty()) return 0;
   auto circle = [&](double rad, bool ccw) {
     const int n = Sweep::circle_segments(rad, tol);
-    const double rho = rad * Sweep::circle_grow_area(n);
+    const double rho = rad * 2.0 / (1.0 + std::cos(std::numbers::pi / n));
     Path c;
     c.reserve(static_cast<std::size_t>(n));
     for (int k = 0; k < n; ++k) {
