@@ -15,22 +15,11 @@
 using namespace lbr;
 using geom::ToolKind;
 
+using test::helix;
+
 namespace {
 
 constexpr double kTol = 0.001;
-
-// Helix around (cx, cy) with radius rho from z0, `turns` turns of `pitch` downwards, then one
-// flat turn at the bottom; `per_turn` chords per turn.
-std::vector<geom::Vec3> helix(double cx, double cy, double rho, double z0, double pitch, int turns, int per_turn) {
-  std::vector<geom::Vec3> p;
-  const int n = (turns + 1) * per_turn;
-  for (int i = 0; i <= n; ++i) {
-    const double a = 2.0 * test::kPi * i / per_turn;
-    const double z = z0 - pitch * std::min(static_cast<double>(i) / per_turn, static_cast<double>(turns));
-    p.push_back({cx + rho * std::cos(a), cy + rho * std::sin(a), z});
-  }
-  return p;
-}
 
 // Largest difference of level areas between two solids [mm²].
 double max_level_area_gap(const geom::LbrSolid& a, const geom::LbrSolid& b) {

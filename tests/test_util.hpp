@@ -72,4 +72,17 @@ inline void append_pocket_path(std::vector<geom::Vec3>& p) {
 }
 inline constexpr double kPocketVolume = (30.0 * 20.0 - (4.0 - kPi) * 9.0) * 4.0;
 
+// Helix around (cx, cy) with radius rho from z0, `turns` turns of `pitch` downwards, then one
+// flat turn at the bottom; `per_turn` chords per turn.
+inline std::vector<geom::Vec3> helix(double cx, double cy, double rho, double z0, double pitch, int turns, int per_turn) {
+  std::vector<geom::Vec3> p;
+  const int n = (turns + 1) * per_turn;
+  for (int i = 0; i <= n; ++i) {
+    const double a = 2.0 * kPi * i / per_turn;
+    const double z = z0 - pitch * std::min(static_cast<double>(i) / per_turn, static_cast<double>(turns));
+    p.push_back({cx + rho * std::cos(a), cy + rho * std::sin(a), z});
+  }
+  return p;
+}
+
 }  // namespace lbr::test
