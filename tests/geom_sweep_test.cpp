@@ -36,9 +36,20 @@ double section_area_mm2(const geom::Sweep& s, double z, std::size_t* count = nul
 
 TEST(Sweep, CircleSegmentsFollowTolerance) {
   const int n = geom::Sweep::circle_segments(5.0, kTol);
-  // Chord band of an n-gon on radius 5 within 1 µm.
-  EXPECT_LE(5.0 * (1.0 - std::cos(test::kPi / n)), kTol);
-  EXPECT_GT(5.0 * (1.0 - std::cos(test::kPi / (n - 2))), kTol * 0.9);
+  // Both polygons on radius 5 deviate from the circle by at most 1 µm on either side, and
+  // n is the least such count (within the rounding of the start).
+  auto worst = [](double g, int k) { return 5.0 * std::max(g - 1.0, 1.0 - g * std::cos(test::kPi / k)); };
+  EXPECT_LE(worst(geom::Sweep::circle_grow_width(n), n), kTol);
+  EXPECT_LE(worst(geom::Sweep::circle_grow_area(n), n), kTol);
+  EXPECT_GT(worst(geom::Sweep::circle_grow_width(n - 2), n - 2), kTol);
+  // Width-keeping: the mean of the polygon's support function, ρ·sin θ / θ, is the radius;
+  // area-keeping: n·ρ²·sin θ·cos θ is π·r².
+  const double th = test::kPi / n;
+  EXPECT_NEAR(geom::Sweep::circle_grow_width(n) * std::sin(th) / th, 1.0, 1e-12);
+  const double ga = geom::Sweep::circle_grow_area(n);
+  EXPECT_NEAR(n * ga * ga * std::sin(th) * std::cos(th), test::kPi, 1e-12);
+  // The vertices are on both sides: outside the circle by about r·θ²/6 (width-keeping).
+  EXPECT_GT(5.0 * (geom::Sweep::circle_grow_width(n) - 1.0), 0.4 * kTol);
   EXPECT_EQ(geom::Sweep::circle_segments(0.0, kTol), 1);
   EXPECT_EQ(geom::Sweep::circle_segments(1e-6, kTol), 8);
 }
@@ -196,7 +207,9 @@ TEST(Sweep, RampSectionsMatchTheExactSupportFunction) {
         ASSERT_GE(cr, -1.5 * (std::hypot(ex, ey) + std::hypot(fx, fy))) << geom::to_string(t.kind) << " move " << m << " vertex " << i;
       }
       const int n = geom::Sweep::circle_segments(rmax, kTol);
-      const double band = rmax * (2.0 / (1.0 + std::cos(test::kPi / n)) - 1.0);
+      // The polygons' support is within ρ·cos(π/n) .. ρ of the disks' (ρ = r·circle_grow_width(n)).
+      const double g = geom::Sweep::circle_grow_width(n);
+      const double band = rmax * std::max(g - 1.0, 1.0 - g * std::cos(test::kPi / n));
       for (int k = 0; k < 720; ++k) {
         const double ux = std::cos(k * test::kPi / 360), uy = std::sin(k * test::kPi / 360);
         double exact = -INFINITY;

@@ -34,7 +34,7 @@ TEST(Tool, ValidationNamesTheProblem) {
 
 class ShapeTolerance : public ::testing::TestWithParam<std::tuple<ToolKind, double, double>> {};
 
-TEST_P(ShapeTolerance, LinearProfileWithinChordToleranceAndInscribed) {
+TEST_P(ShapeTolerance, LinearProfileWithinChordToleranceOnBothSides) {
   const auto [kind, d, param] = GetParam();
   for (double tol : {0.001, 0.01}) {
     const geom::Tool t = test::tool(kind, d, param, 20.0);
@@ -42,20 +42,46 @@ TEST_P(ShapeTolerance, LinearProfileWithinChordToleranceAndInscribed) {
     ASSERT_GE(s.stations.size(), 2u);
     EXPECT_DOUBLE_EQ(s.stations.front().h, 0.0);
     EXPECT_DOUBLE_EQ(s.height(), 20.0);
-    // Distance of the linear profile from the exact one, measured normal to the exact
-    // profile: on the corner arc it is the gap to the arc's circle, elsewhere the profile is
-    // straight and must match exactly.
+    // Signed distance of the linear profile from the exact one, measured normal to the exact
+    // profile (positive inside): on the corner arc it is the gap to the arc's circle,
+    // elsewhere the profile is straight and must match exactly.
     const double R = 0.5 * d;
     const double rc = kind == ToolKind::Ball ? R : (kind == ToolKind::Bull ? param : 0.0);
-    double worst = 0.0;
+    double inside = 0.0, outside = 0.0;
     for (int i = 0; i <= 20000; ++i) {
       const double h = 20.0 * i / 20000.0;
       const double exact = t.radius_at(h), lin = s.radius_at(h);
-      EXPECT_LE(lin, exact + 1e-12) << "h " << h;
+      EXPECT_LE(lin, R + 1e-12) << "h " << h;  // never wider than the tool
       const double gap = (rc > 0.0 && h < rc) ? rc - std::hypot(lin - (R - rc), h - rc) : exact - lin;
-      worst = std::max(worst, gap);
+      inside = std::max(inside, gap);
+      outside = std::max(outside, -gap);
     }
-    EXPECT_LE(worst, tol * 1.0001 + 1e-12) << geom::to_string(kind) << " tol " << tol;
+    EXPECT_LE(inside, tol * 1.0001 + 1e-12) << geom::to_string(kind) << " tol " << tol;
+    EXPECT_LE(outside, tol * 1.0001 + 1e-12) << geom::to_string(kind) << " tol " << tol;
+    if (rc > 0.0) {  // the corner arc's polyline lies on both sides of the arc
+      EXPECT_GT(inside, 0.1 * tol) << geom::to_string(kind) << " tol " << tol;
+      EXPECT_GT(outside, 0.1 * tol) << geom::to_string(kind) << " tol " << tol;
+    }
+  }
+}
+
+// The corner arc's polyline keeps the arc's mean support (Sweep::circle_grow_width()): the
+// mean over the arc's directions of the polyline's support minus the arc's is zero to within
+// a small fraction of the tolerance, so a ball end removes neither more nor less on average.
+TEST(Tool, CornerPolylineHasNoSupportBias) {
+  for (double tol : {0.001, 0.01}) {
+    const geom::Tool t = test::tool(ToolKind::Ball, 6.0, 0.0, 20.0);
+    const geom::CutterShape s = geom::CutterShape::build(t, tol);
+    const double rc = 3.0;
+    double sum = 0.0;
+    const int m = 100000;
+    for (int i = 0; i < m; ++i) {
+      const double a = 0.5 * test::kPi * (i + 0.5) / m;  // direction (sin a, -cos a) in (r, h)
+      double best = -INFINITY;  // support of the stations about the corner centre (0, rc)
+      for (const auto& st : s.stations) best = std::max(best, st.r * std::sin(a) - (st.h - rc) * std::cos(a));
+      sum += best - rc;
+    }
+    EXPECT_NEAR(sum / m, 0.0, 0.05 * tol) << "tol " << tol;
   }
 }
 

@@ -228,11 +228,11 @@ void SubtractEngine::size_storage(SubtractShared& sh) const {
   sh.outcome.assign(n * static_cast<std::size_t>(s_.regions()), 0);
   if (sh.offsets.size() < noff) sh.offsets.resize(noff);
   for (std::size_t o = 0; o < noff; ++o) {
-    // The box from the polyline's box (conservative: the offset lies within r + tol/4 of
+    // The box from the polyline's box (conservative: the offset lies within r + tol of
     // it), so that levels can be built while the offsets are being computed.
     SubtractShared::Offset& off = sh.offsets[o];
     const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
-    const Coord d = static_cast<Coord>(std::ceil((sh.offset_keys[o].r + 0.25 * c.shape->chord_tol_mm) * kUnitsPerMm)) + 2;
+    const Coord d = static_cast<Coord>(std::ceil((sh.offset_keys[o].r + c.shape->chord_tol_mm) * kUnitsPerMm)) + 2;
     const Rect b = bounds_of(c.pts);
     off.box = Rect{b.x0 - d, b.y0 - d, b.x1 + d, b.y1 + d};
     off.ix0 = interval_of(s_.xs_, off.box.x0);

@@ -48,6 +48,28 @@ bool drop_sections_in_air(const Cell& cell, const LevelSections& ls, SubtractWor
   return kept > 0;
 }
 
+// Clipper rounds the crossings of edges to the unit grid, and where a clip edge crosses a
+// subject edge at a very shallow angle near the region's border the rounded point can land
+// a few units beyond the subject, so beyond the region (seen: 4 units, a tilted ball raster,
+// tests/geom_joined_test.cpp, Joined.TiltedRasterCutInOneBatchEqualsTheMovesCutOneByOne).
+// Rare: only then is the result intersected with the region's rectangle (whose sides are
+// axis-parallel, so its crossings lie on it exactly).
+void keep_in_region(const Rect& rr, SubtractWorkspace& ws) {
+  const bool out = std::any_of(ws.fresh.begin(), ws.fresh.end(), [&](const Polygon& p) { return !contains(rr, p.bbox); });
+  if (!out) return;
+  ClipperLib::Clipper& k = ws.rect_clipper;
+  k.Clear();
+  for (const Polygon& p : ws.fresh) {
+    k.AddPath(p.outer.pts, ClipperLib::ptSubject, true);
+    for (const Contour& h : p.holes) k.AddPath(h.pts, ClipperLib::ptSubject, true);
+  }
+  k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
+  ws.tree.Clear();
+  k.Execute(ClipperLib::ctIntersection, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  ws.fresh.clear();
+  append_polygons(ws.tree, ws.fresh);
+}
+
 // A difference that removes no more than the rounding of intersection points to the unit
 // grid can account for (half a unit along the touched perimeter) is noise, e.g. a second
 // pass along the same path: the caller keeps the old polygons, vertex for vertex.
@@ -184,6 +206,7 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
   ++stats.cells_clipped;
   ws.fresh.clear();
   append_polygons(ws.tree, ws.fresh);
+  keep_in_region(s_.region_rect(region), ws);
   if (removes_only_noise(cell, ws) || !inherit_move_ids(cell, ls, ws)) return false;
 
   replace_touched(cell, ws);

@@ -127,7 +127,7 @@ Path LbrSolid::stock_circle() const {
   const CylinderStock& c = spec_.cylinder;
   const double r = 0.5 * c.diameter_mm;
   const int segs = Sweep::circle_segments(r, spec_.chord_tol_mm);
-  const double rho = r * 2.0 / (1.0 + std::cos(std::numbers::pi / segs));
+  const double rho = r * Sweep::circle_grow_area(segs);
   for (int k = 0; k < segs; ++k) {
     const double a = 2.0 * std::numbers::pi * k / segs;
     circle.push_back({to_units(c.center_x_mm + rho * std::cos(a)), to_units(c.center_y_mm + rho * std::sin(a))});
@@ -180,7 +180,7 @@ LbrSolid::CircleCover LbrSolid::circle_vs_rect(const Rect& rr, std::size_t segs)
   const CylinderStock& c = spec_.cylinder;
   const double r = 0.5 * c.diameter_mm * kUnitsPerMm;
   const double pi_n = std::numbers::pi / static_cast<double>(segs);
-  const double rho = r * 2.0 / (1.0 + std::cos(pi_n));
+  const double rho = r * Sweep::circle_grow_area(static_cast<int>(segs));
   const double cx = c.center_x_mm * kUnitsPerMm, cy = c.center_y_mm * kUnitsPerMm;
   const double x0 = static_cast<double>(rr.x0) - cx, x1 = static_cast<double>(rr.x1) - cx;
   const double y0 = static_cast<double>(rr.y0) - cy, y1 = static_cast<double>(rr.y1) - cy;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <numbers>
 
 #include "chain_outline.hpp"
 #include "polygon_ops.hpp"
@@ -18,17 +19,22 @@ namespace {
 constexpr std::size_t kTiltedGroup = 8;
 }  // namespace
 
-// Builds offset `o` of the prepared batch. Offset vertices lie on radius r + tol/4 and
-// chords sag at most tol/2 inside it, so the boundary stays within ±tol/4 of the exact one.
+// Builds offset `o` of the prepared batch. Its round parts are the same n-gons as a tool's
+// disks (Sweep::circle_segments(), circle_grow_width()): vertices on radius δ = r·g with
+// n of them to a full turn (Clipper's arc tolerance δ·(1 − cos(π/n))), so the boundary stays
+// within ±tol of the exact one with no bias on the arcs; straight sides lie at δ, like a
+// stadium's sides along a grid direction.
 void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
   ++stats.chain_offsets;
   const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
   SubtractShared::Offset& off = sh.offsets[o];
-  const double tol = c.shape->chord_tol_mm;
-  ClipperLib::ClipperOffset co(2.0, 0.5 * tol * kUnitsPerMm);
+  const double r = sh.offset_keys[o].r;
+  const int n = Sweep::circle_segments(r, c.shape->chord_tol_mm);
+  const double delta = r * Sweep::circle_grow_width(n) * kUnitsPerMm;
+  ClipperLib::ClipperOffset co(2.0, delta * (1.0 - std::cos(std::numbers::pi / n)));
   co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
   off.paths.clear();
-  co.Execute(off.paths, (sh.offset_keys[o].r + 0.25 * tol) * kUnitsPerMm);
+  co.Execute(off.paths, delta);
 }
 
 namespace {

@@ -234,12 +234,27 @@ double dist_to_line(const P2& p, const P2& a, const P2& b) noexcept {
 
 }  // namespace
 
+double Sweep::circle_grow_width(int n) noexcept {
+  const double th = std::numbers::pi / n;
+  return th / std::sin(th);
+}
+
+double Sweep::circle_grow_area(int n) noexcept {
+  const double th = std::numbers::pi / n;
+  return std::sqrt(th / (std::sin(th) * std::cos(th)));
+}
+
 int Sweep::circle_segments(double r_mm, double chord_tol_mm) noexcept {
   if (!(r_mm > 0.0)) return 1;
-  const double c = 1.0 - std::min(1.0, chord_tol_mm / r_mm);
-  const double step = 2.0 * std::acos(c);
-  if (!(step > 0.0)) return 4096;
-  return std::clamp(static_cast<int>(std::ceil(2.0 * std::numbers::pi / step)), 8, 4096);
+  // Either polygon deviates from the circle by about r·θ²/3 at most (θ = π/n): the width-
+  // keeping one by r·(g − 1) ≈ r·θ²/6 outside at its vertices and r·(1 − g·cos θ) ≈ r·θ²/3
+  // inside at its edges' midpoints, the area-keeping one by r·θ²/3 outside and r·θ²/6
+  // inside. Start from θ = sqrt(3·tol/r) and add vertices while either exceeds tol.
+  const double t = std::min(1.0, chord_tol_mm / r_mm);
+  int n = std::max(8, static_cast<int>(std::ceil(std::numbers::pi / std::sqrt(3.0 * t))));
+  auto within = [&](double g) { return g - 1.0 <= t && 1.0 - g * std::cos(std::numbers::pi / n) <= t; };
+  while (n < 4096 && !(within(circle_grow_width(n)) && within(circle_grow_area(n)))) ++n;
+  return std::min(n, 4096);
 }
 
 Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcept
@@ -328,9 +343,9 @@ std::size_t Sweep::section_vertical(double zc, Paths& out, SectionScratch& sc) c
   for (const auto& d : sc.disks) rmax = std::max(rmax, d.r);
   if (rmax <= 0.0) return 0;
   const int n = circle_segments(rmax, s.chord_tol_mm);
-  // Vertices at ρ = 2r / (1 + cos(π/n)): the polygon then deviates from the circle by at
-  // most ±(ρ - r), i.e. half the chord band, on either side.
-  const double grow = 2.0 / (1.0 + std::cos(std::numbers::pi / n));
+  // Vertices at ρ = r·circle_grow_width(n): each disk's polygon has the disk's mean width
+  // and deviates from its circle by at most tol on either side.
+  const double grow = circle_grow_width(n);
   const std::vector<P2>& uc = sc.unit_circle(n);
   sc.hull.clear();
   if (sc.disks.size() == 2 && sc.disks[0].r == sc.disks[1].r) {
@@ -517,7 +532,7 @@ bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) co
   if (!section_disks(zc, sc)) return false;
   const auto& ds = sc.disks;
   if (ds.front().role != 1 || ds.back().role != 2 || !(ds.front().r > 0.0) || !(ds.back().r > 0.0)) return false;
-  const double grow = 2.0 / (1.0 + std::cos(std::numbers::pi / n));
+  const double grow = circle_grow_width(n);
   out.c0 = {ds.front().x, ds.front().y};
   out.c1 = {ds.back().x, ds.back().y};
   out.rho0 = ds.front().r * grow;

@@ -1,6 +1,8 @@
 // Tool profiles: exact r(h) and its piecewise-linear approximation within the chord tolerance.
 #include "geom/tool.hpp"
 
+#include "geom/sweep.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -109,17 +111,23 @@ CutterShape CutterShape::build(const Tool& tool, double chord_tol_mm) {
     case ToolKind::Ball:
     case ToolKind::Bull: {
       const double rc = corner_radius(tool);
-      // Inscribed polyline on the corner arc, angle step chosen so the sagitta <= tol.
-      const double step = 2.0 * std::acos(std::max(-1.0, 1.0 - chord_tol_mm / rc));
-      const int n = std::max(2, static_cast<int>(std::ceil(0.5 * std::numbers::pi / step)));
-      for (int i = 0; i <= n; ++i) {
-        const double a = 0.5 * std::numbers::pi * i / n;
-        const double h = rc * (1.0 - std::cos(a));
+      // The corner arc (a quarter turn about the corner centre) as a piece of a tool disk's
+      // polygon (Sweep::circle_segments()): n vertices at angles (i − ½)·(π/2)/n on radius
+      // rc·circle_grow_width(4n), which keep the arc's mean support (no bias in what the
+      // tool removes) and deviate from it by at most tol on either side, joined to the arc's
+      // exact ends (the tip or the flat's rim, and the flank).
+      const int n = std::max(2, (Sweep::circle_segments(rc, chord_tol_mm) + 3) / 4);
+      const double rho = rc * Sweep::circle_grow_width(4 * n);
+      const double step = 0.5 * std::numbers::pi / n;
+      for (int i = 0; i <= n + 1; ++i) {
+        const double a = i == 0 ? 0.0 : i == n + 1 ? 0.5 * std::numbers::pi : (i - 0.5) * step;
+        const double rad = i == 0 || i == n + 1 ? rc : rho;
+        const double h = rc - rad * std::cos(a);
         if (h > top) {
           push(top, tool.radius_at(top));
           break;
         }
-        push(h, (r - rc) + rc * std::sin(a));
+        push(h, (r - rc) + rad * std::sin(a));
       }
       break;
     }

@@ -204,10 +204,10 @@ std::size_t LatheSweep::removed_region(double r, bool inside, double tol, const 
 }
 
 namespace {
-// A circle polygonised like a tool section (vertices at rho = 2r / (1 + cos(pi / n))).
+// A circle polygonised like a tool section (vertices at rho = r * Sweep::circle_grow_area(n)).
 void append_circle(double rad, bool ccw, double tol, Paths& out) {
   const int n = Sweep::circle_segments(rad, tol);
-  const double rho = rad * 2.0 / (1.0 + std::cos(std::numbers::pi / n));
+  const double rho = rad * Sweep::circle_grow_area(n);
   Path c;
   c.reserve(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) {

@@ -144,9 +144,18 @@ class Sweep {
   // section would remove nothing.
   std::size_t section(double z_mm, Paths& out, SectionScratch& scratch, const Rect* material = nullptr) const;
 
-  // Number of polygon vertices used for a full circle of radius r [mm] at the shape's chord
-  // tolerance (at least 8, at most 4096).
+  // Circles become regular n-gons that deviate from them on both sides, so that they carry no
+  // bias (docs/lbr-conventions.md, "Tolerances"): vertices on radius r·g, outside the circle
+  // near the vertices and inside near the edges' midpoints. A tool's disks and profile, which
+  // remove material by their support (a sweep's side lies at the tool's support in the
+  // direction normal to it), keep the circle's mean width: g = circle_grow_width(n) =
+  // θ / sin θ (θ = π/n). Regions bounded by a circle (a cylinder stock, a lathe's turned
+  // radius) keep its area: g = circle_grow_area(n) = sqrt(θ / (sin θ·cos θ)).
+  // circle_segments() is the least n (at least 8, at most 4096) for which both polygons
+  // stay within the chord tolerance of the circle.
   [[nodiscard]] static int circle_segments(double r_mm, double chord_tol_mm) noexcept;
+  [[nodiscard]] static double circle_grow_width(int n) noexcept;
+  [[nodiscard]] static double circle_grow_area(int n) noexcept;
 
   // Vertical sweeps only: the section on z = z_mm on the grid of n directions, split into
   // caps and sides (MoveCaps). False when the section has no start or no end disk on its

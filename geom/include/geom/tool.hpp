@@ -46,7 +46,9 @@ struct Tool {
 };
 
 // Piecewise-linear cutting profile that never deviates from the exact profile by more than
-// the chord tolerance (inscribed: the linear profile lies inside the true one). Built once
+// the chord tolerance, on either side: the corner arc's polyline keeps the arc's area, so the
+// profile is not biased inwards or outwards (docs/lbr-conventions.md, "Tolerances"); its
+// radius never exceeds the tool's radius. Built once
 // per tool at setup (allocates); read-only afterwards.
 struct CutterShape {
   struct Station {
