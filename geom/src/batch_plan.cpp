@@ -187,6 +187,8 @@ void SubtractEngine::prepare(std::span<const SweepRef> batch, SubtractShared& sh
   sh.le = nothing ? 0 : s_.level_at(zhi) + 1;
   plan_offsets(sh);
   size_storage(sh);
+  sh.border_x = std::span<const Coord>(s_.xs_).subspan(1, s_.xs_.size() - 2);
+  sh.border_y = std::span<const Coord>(s_.ys_).subspan(1, s_.ys_.size() - 2);
   for (auto& next : sh.next) next.store(0, std::memory_order_relaxed);
   sh.ahead_ready.store(0, std::memory_order_relaxed);
   sh.offsets_ready = false;

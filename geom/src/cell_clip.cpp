@@ -70,6 +70,30 @@ void keep_in_region(const Rect& rr, SubtractWorkspace& ws) {
   append_polygons(ws.tree, ws.fresh);
 }
 
+// Clipper's result without the slivers its rounding leaves (remove_slivers(), within
+// kSliverUnits): two sections whose edges run within a unit of each other leave a spike a
+// unit wide between them, and where it reaches a region border the neighbour's contour
+// does not follow it (docs/mesh.md §6). Vertices on the region's sides stay.
+void drop_slivers(const Rect& rr, SubtractWorkspace& ws) {
+  constexpr double kSliverUnits = 1.415;  // just over a diagonal grid step
+  std::size_t kept = 0;
+  for (Polygon& poly : ws.fresh) {
+    if (remove_slivers(poly.outer.pts, rr, kSliverUnits, ws.cut_tmp)) poly.bbox = bounds_of(poly.outer.pts);
+    if (poly.outer.pts.empty()) continue;
+    std::size_t holes = 0;
+    for (Contour& h : poly.holes) {
+      remove_slivers(h.pts, rr, kSliverUnits, ws.cut_tmp);
+      if (h.pts.empty()) continue;
+      if (&poly.holes[holes] != &h) poly.holes[holes] = std::move(h);
+      ++holes;
+    }
+    poly.holes.resize(holes);
+    if (&ws.fresh[kept] != &poly) ws.fresh[kept] = std::move(poly);
+    ++kept;
+  }
+  ws.fresh.resize(kept);
+}
+
 // A difference that removes no more than the rounding of intersection points to the unit
 // grid can account for (half a unit along the touched perimeter) is noise, e.g. a second
 // pass along the same path: the caller keeps the old polygons, vertex for vertex.
@@ -207,6 +231,7 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
   ws.fresh.clear();
   append_polygons(ws.tree, ws.fresh);
   keep_in_region(s_.region_rect(region), ws);
+  drop_slivers(s_.region_rect(region), ws);
   if (removes_only_noise(cell, ws) || !inherit_move_ids(cell, ls, ws)) return false;
 
   replace_touched(cell, ws);

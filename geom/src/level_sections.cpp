@@ -74,6 +74,8 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
   ls.reach_end.resize(ls.paths.size(), kNoReach);
   add_chain_sections(level, sh, ls);
   add_lathe_sections(zc, sh, ls);
+  for (std::size_t k = 0; k < ls.paths.size(); ++k)
+    if (ls.chain[k] == kNoChain) split_at_lines(ls.paths[k], sh.border_x, sh.border_y, ws.cut_tmp);
   stats.sections += ls.paths.size();
   if (ls.paths.empty() || !ls.all.intersects(s_.xy_)) return;
   ls.ix0 = interval_of(s_.xs_, ls.all.x0);

@@ -140,6 +140,157 @@ void clip_pass(const Path& in, Path& out, Inside inside, Project project) {
 
 }  // namespace
 
+namespace {
+
+// The v coordinate at u of the segment (pu, pv)-(qu, pv), pu != qu, rounded half away from
+// zero; the endpoints are ordered first, so both directions give the same value.
+Coord v_at(Coord pu, Coord pv, Coord qu, Coord qv, Coord u) noexcept {
+  if (qu < pu || (qu == pu && qv < pv)) {
+    std::swap(pu, qu);
+    std::swap(pv, qv);
+  }
+  const Coord num = (qv - pv) * (u - pu), den = qu - pu;  // |num| < 2^62 for coordinates < 2^31
+  const Coord q = num >= 0 ? (2 * num + den) / (2 * den) : -((-2 * num + den) / (2 * den));
+  return pv + q;
+}
+
+// The lines strictly between a and b in the order the edge a -> b meets them: [first, last)
+// walked with `step` (+1 or -1) from index `first`.
+struct LineWalk {
+  std::ptrdiff_t i = 0, end = 0, step = 1;
+  [[nodiscard]] bool more() const noexcept { return i != end; }
+};
+
+LineWalk walk(std::span<const Coord> lines, Coord a, Coord b) noexcept {
+  const auto lo = std::upper_bound(lines.begin(), lines.end(), std::min(a, b)) - lines.begin();
+  const auto hi = std::lower_bound(lines.begin(), lines.end(), std::max(a, b)) - lines.begin();
+  if (lo >= hi) return LineWalk{0, 0, 1};
+  return a < b ? LineWalk{lo, hi, 1} : LineWalk{hi - 1, lo - 1, -1};
+}
+
+// Appends the crossings of the edge a -> b with the lines, in order along the edge (the
+// x lines' and the y lines' merged by their parameter), without repeating a point.
+void append_crossings(const Point& a, const Point& b, std::span<const Coord> xs, std::span<const Coord> ys, Path& out) {
+  LineWalk wx = walk(xs, a.X, b.X), wy = walk(ys, a.Y, b.Y);
+  const double dx = static_cast<double>(b.X - a.X), dy = static_cast<double>(b.Y - a.Y);
+  auto push = [&](const Point& p) {
+    if (out.empty() || !(out.back() == p)) out.push_back(p);
+  };
+  while (wx.more() || wy.more()) {
+    const double tx = wx.more() ? static_cast<double>(xs[static_cast<std::size_t>(wx.i)] - a.X) / dx : 2.0;
+    const double ty = wy.more() ? static_cast<double>(ys[static_cast<std::size_t>(wy.i)] - a.Y) / dy : 2.0;
+    if (tx <= ty) {
+      const Coord x = xs[static_cast<std::size_t>(wx.i)];
+      push(Point{x, v_at(a.X, a.Y, b.X, b.Y, x)});
+      wx.i += wx.step;
+    } else {
+      const Coord y = ys[static_cast<std::size_t>(wy.i)];
+      push(Point{v_at(a.Y, a.X, b.Y, b.X, y), y});
+      wy.i += wy.step;
+    }
+  }
+}
+
+// Some line lies strictly between lo and hi.
+bool spans_line(std::span<const Coord> lines, Coord lo, Coord hi) noexcept {
+  const auto it = std::upper_bound(lines.begin(), lines.end(), lo);
+  return it != lines.end() && *it < hi;
+}
+
+}  // namespace
+
+void split_at_lines(Path& path, std::span<const Coord> xs, std::span<const Coord> ys, Path& tmp) {
+  if (path.size() < 2) return;
+  const Rect b = bounds_of(path);
+  if (!spans_line(xs, b.x0, b.x1) && !spans_line(ys, b.y0, b.y1)) return;
+  tmp.clear();
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const Point& a = path[i];
+    tmp.push_back(a);
+    append_crossings(a, path[i + 1 < path.size() ? i + 1 : 0], xs, ys, tmp);
+  }
+  path.swap(tmp);
+}
+
+namespace {
+
+double dist2(const Point& a, const Point& b) noexcept {
+  const double dx = static_cast<double>(a.X - b.X), dy = static_cast<double>(a.Y - b.Y);
+  return dx * dx + dy * dy;
+}
+
+// Squared distance of p from the line through a and b (a != b).
+double line_dist2(const Point& p, const Point& a, const Point& b) noexcept {
+  const double ux = static_cast<double>(b.X - a.X), uy = static_cast<double>(b.Y - a.Y);
+  const double c = ux * static_cast<double>(p.Y - a.Y) - uy * static_cast<double>(p.X - a.X);
+  return c * c / (ux * ux + uy * uy);
+}
+
+// prev, cur and next are almost on one line: the one of the three that lies between the
+// other two (along the dominant axis) is within sqrt(d2) of the line through them. When
+// cur is the tip of a thin spike, prev or next is the one between.
+bool near_collinear(const Point& prev, const Point& cur, const Point& next, double d2) noexcept {
+  const bool by_x = std::abs(prev.X - cur.X) > std::abs(prev.Y - cur.Y);
+  auto key = [by_x](const Point& p) { return by_x ? p.X : p.Y; };
+  const Coord a = key(prev), b = key(cur), c = key(next);
+  if ((a > b) == (a < c) && !(cur == next)) return line_dist2(prev, cur, next) < d2;
+  if ((b > a) == (b < c) && !(prev == next)) return line_dist2(cur, prev, next) < d2;
+  if (prev == cur) return true;
+  return line_dist2(next, prev, cur) < d2;
+}
+
+// The contour turns back at cur (the tip of a spike).
+bool backtracks(const Point& prev, const Point& cur, const Point& next) noexcept {
+  return static_cast<double>(cur.X - prev.X) * static_cast<double>(next.X - cur.X) +
+             static_cast<double>(cur.Y - prev.Y) * static_cast<double>(next.Y - cur.Y) <
+         0.0;
+}
+
+bool on_side(const Point& p, const Rect& r) noexcept { return p.X == r.x0 || p.X == r.x1 || p.Y == r.y0 || p.Y == r.y1; }
+
+// a and b lie on one side of r: the edge a-b runs along the region's border.
+bool along_side(const Point& a, const Point& b, const Rect& r) noexcept {
+  return (a.X == b.X && (a.X == r.x0 || a.X == r.x1)) || (a.Y == b.Y && (a.Y == r.y0 || a.Y == r.y1));
+}
+
+// cur, on a side of r, is the tip of a spike that can go: the contour turns back there
+// within sqrt(d2) of a line, and no edge along the border longer than that goes with it
+// (that edge is what the neighbour region's contour meets).
+bool spike_on_side(const Point& prev, const Point& cur, const Point& next, const Rect& r, double d2) noexcept {
+  if (along_side(prev, cur, r) && dist2(prev, cur) >= d2) return false;
+  if (along_side(cur, next, r) && dist2(cur, next) >= d2) return false;
+  return backtracks(prev, cur, next) && near_collinear(prev, cur, next, d2);
+}
+
+}  // namespace
+
+bool remove_slivers(Path& contour, const Rect& keep, double dist, Path& tmp) {
+  const double d2 = dist * dist;
+  bool changed = false, pass = true;
+  while (pass && contour.size() >= 3) {
+    pass = false;
+    tmp.clear();
+    const std::size_t n = contour.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point& cur = contour[i];
+      const Point& prev = tmp.empty() ? contour[n - 1] : tmp.back();
+      const Point& next = contour[i + 1 < n ? i + 1 : 0];
+      if (on_side(cur, keep) ? spike_on_side(prev, cur, next, keep, d2)
+                             : dist2(cur, prev) < d2 || dist2(cur, next) < d2 || near_collinear(prev, cur, next, d2)) {
+        pass = changed = true;
+        continue;
+      }
+      tmp.push_back(cur);
+    }
+    contour.swap(tmp);
+  }
+  if (contour.size() < 3 && !contour.empty()) {
+    contour.clear();
+    changed = true;
+  }
+  return changed;
+}
+
 void cut_to_rect(const Path& in, const Rect& r, Path& out, Path& tmp) {
   clip_pass(in, tmp, [&](const Point& p) { return p.X > r.x0; }, [&](const Point& p) { return Point{r.x0, p.Y}; });
   clip_pass(tmp, out, [&](const Point& p) { return p.X < r.x1; }, [&](const Point& p) { return Point{r.x1, p.Y}; });

@@ -1,6 +1,7 @@
 // Private helpers over Clipper's types used by the solid and by serialisation.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "geom/lbr_solid.hpp"
@@ -23,6 +24,26 @@ void append_polygons(const ClipperLib::PolyTree& tree, std::vector<Polygon>& out
 // number of every point: the replaced parts lie outside. A self-overlapping outline keeps
 // its non-zero region inside r. Allocates only when the buffers grow.
 void cut_to_rect(const Path& in, const Rect& r, Path& out, Path& tmp);
+
+// Splits every edge of the closed path where it crosses one of the lines x = xs[i] or
+// y = ys[j] (each sorted ascending), with a vertex at the crossing rounded to the unit grid
+// (half away from zero), computed from the edge's endpoints in a fixed order so that an
+// edge and its reverse give the same point. Region borders: a section crosses a border at
+// a vertex that every region's clip sees, instead of at a point each clip rounds on its own
+// (a crossing half a unit between grid points went either way, region by region; docs/mesh.md).
+// Unchanged when its box spans no line. `tmp` is a scratch buffer; allocates only when the
+// buffers grow.
+void split_at_lines(Path& path, std::span<const Coord> xs, std::span<const Coord> ys, Path& tmp);
+
+// Removes the slivers that rounding crossings to the unit grid leaves in a clip's result
+// (docs/mesh.md §6): repeatedly, a vertex within `dist` [units] of a neighbour, or one whose
+// removal moves the contour by less than `dist` (a vertex almost on the line through its
+// neighbours, or the tip of a spike one unit wide). On a side of `keep` (the region's
+// rectangle: its border vertices are what the neighbour's contours meet) only the tip of
+// such a spike goes.
+// A contour left with fewer than 3 vertices is emptied. Returns true when it changed.
+// `tmp` is a scratch buffer.
+bool remove_slivers(Path& contour, const Rect& keep, double dist, Path& tmp);
 
 // b lies wholly inside a.
 [[nodiscard]] inline bool contains(const Rect& a, const Rect& b) noexcept {

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -75,6 +76,9 @@ struct SubtractShared {
   std::vector<std::uint32_t> offset_of;    // per (level - lb, chain): index into offset_keys, or ~0
   int lb = 0, le = 0;                      // the levels the batch reaches: [lb, le)
   bool offsets_ready = false;              // the offsets' paths are built (during the batch before)
+  // The regions' inner borders (the solid's xs_/ys_ without the first and last): sections
+  // and offsets get a vertex where they cross one (split_at_lines()).
+  std::span<const Coord> border_x, border_y;
 
   // --- built by the threads ---
   std::vector<LevelSections> levels;    // per level the batch reaches, reused between batches
