@@ -274,7 +274,7 @@ double max_dist_to_segment(V2 a, V2 b, double d2, V2 p) noexcept { return std::m
 
 }  // namespace
 
-double reach_band_units(double chord_tol_mm) noexcept { return 1.5 * chord_tol_mm * kUnitsPerMm + 2.0; }
+double reach_band_units(double chord_tol_mm) noexcept { return 2.0 * chord_tol_mm * kUnitsPerMm + 2.0; }
 
 void add_outline_reach(std::span<const MoveCaps> moves, double band_units, std::vector<ReachCapsule>& out) {
   const double k = kUnitsPerMm;

@@ -63,8 +63,9 @@ struct ReachScratch {
 };
 
 // The width of the band [units] a skipped clip may leave unremoved, below the section's
-// vertex radius: the chord tolerance's ±tol/2 about the exact circle, tol/2 for a merged
-// sampled chord, and two units for rounding (docs/lbr-conventions.md, "Tolerances").
+// vertex radius: a two-sided polygon's chords come up to 1.5·tol inside its vertex radius
+// (vertices tol/2 outside the exact circle, chords up to tol inside; docs/lbr-conventions.md,
+// "Two-sided polygons"), tol/2 for a merged sampled chord, and two units for rounding.
 [[nodiscard]] double reach_band_units(double chord_tol_mm) noexcept;
 
 // Appends one capsule per move of a joined outline: the segment c0–c1 and the largest
