@@ -209,7 +209,7 @@ void split_at_lines(Path& path, std::span<const Coord> xs, std::span<const Coord
     tmp.push_back(a);
     append_crossings(a, path[i + 1 < path.size() ? i + 1 : 0], xs, ys, tmp);
   }
-  path.swap(tmp);
+  path.assign(tmp.begin(), tmp.end());  // (not a swap: the scratch buffer keeps its capacity)
 }
 
 namespace {
@@ -282,7 +282,7 @@ bool remove_slivers(Path& contour, const Rect& keep, double dist, Path& tmp) {
       }
       tmp.push_back(cur);
     }
-    contour.swap(tmp);
+    contour.assign(tmp.begin(), tmp.end());  // (a swap would hand the cell the scratch buffer's capacity)
   }
   if (contour.size() < 3 && !contour.empty()) {
     contour.clear();
