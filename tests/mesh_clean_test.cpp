@@ -112,9 +112,10 @@ TEST(MeshClean, CamPocketSampled) {
   // triangulation overlaps itself where two levels' contours share a straight stretch at
   // y = 79.0001 mm and touch it from the same side (levels 270-273; docs/mesh.md §6). Since
   // the emulator blends corners (issue 14 item 3) a fifth of that kind at (50, 60.999, -3);
-  // since the two-sided section polygons three more at z = -3 ((29.12, 37.71) twice and
-  // (57.85, 20.52)).
-  expect_clean(check_part(r.solid), 1, "cam-pocket --sampled", 8);
+  // since the two-sided section polygons three more at z = -3. Since export drops
+  // zero-thickness fins and pulls touching sheets apart (mesh/src/sheets.cpp) 2 are left,
+  // at (29.13, 37.68, -3): cap triangles that overlap with one orientation.
+  expect_clean(check_part(r.solid), 1, "cam-pocket --sampled", 2);
 }
 
 TEST(MeshClean, HighWorkload) {
