@@ -103,36 +103,44 @@ struct ArcCase {
 
 class GcodeArc : public ::testing::TestWithParam<ArcCase> {};
 
-TEST_P(GcodeArc, PointsOnCircleWithinChordToleranceAndSweep) {
+// Two-sided chords (nc/src/path_builder.cpp): the inner vertices on radius r·θ/sin θ (θ half
+// a chord's angle), the end point on the arc; every chord within the tolerance on both sides.
+TEST_P(GcodeArc, PointsWithinChordToleranceOnBothSidesAndSweep) {
   const ArcCase& c = GetParam();
   GcodeOptions o;
   o.chord_tol_mm = 0.001;
   const Toolpath tp = run(c.program, o);
   const std::vector<AxisVector> pts = points_of_line(tp, c.arc_line);
   ASSERT_FALSE(pts.empty());
+  // Chord count: the smallest with the end chords' deviation (5/12 r θ²) within tol.
+  const double step = 2.0 * std::sqrt(2.35 * 0.001 / c.r);
+  EXPECT_EQ(static_cast<double>(pts.size()), std::ceil(std::abs(c.sweep) / step));
+  const double half = 0.5 * std::abs(c.sweep) / static_cast<double>(pts.size());
+  const double rho = pts.size() > 1 ? c.r * half / std::sin(half) : c.r;
   // Start of the arc: the end of the segment before it.
   std::size_t first = 0;
   while (tp.segments[first].line != c.arc_line) ++first;
   AxisVector prev = first == 0 ? tp.start : tp.segments[first - 1].end;
-  double swept = 0.0;
-  double worst_sag = 0.0;
-  for (const AxisVector& p : pts) {
-    EXPECT_NEAR(std::hypot(p[c.u] - c.cu, p[c.v] - c.cv), c.r, 1e-9);
-    // Chord midpoint: its distance inside the circle is the chord's deviation from the arc.
-    const double mu = 0.5 * (p[c.u] + prev[c.u]) - c.cu, mv = 0.5 * (p[c.v] + prev[c.v]) - c.cv;
-    worst_sag = std::max(worst_sag, c.r - std::hypot(mu, mv));
+  double swept = 0.0, worst_in = 0.0, worst_out = 0.0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const AxisVector& p = pts[i];
+    const double radius = std::hypot(p[c.u] - c.cu, p[c.v] - c.cv);
+    EXPECT_NEAR(radius, i + 1 == pts.size() ? c.r : rho, 1e-9);
+    worst_out = std::max(worst_out, radius - c.r);
+    // Closest point of the chord to the centre: its distance inside the circle.
+    const double au = prev[c.u] - c.cu, av = prev[c.v] - c.cv, du = p[c.u] - prev[c.u], dv = p[c.v] - prev[c.v];
+    const double t = std::clamp(-(au * du + av * dv) / (du * du + dv * dv), 0.0, 1.0);
+    worst_in = std::max(worst_in, c.r - std::hypot(au + t * du, av + t * dv));
     double d = std::atan2(p[c.v] - c.cv, p[c.u] - c.cu) - std::atan2(prev[c.v] - c.cv, prev[c.u] - c.cu);
     while (d > std::numbers::pi) d -= 2 * std::numbers::pi;
     while (d < -std::numbers::pi) d += 2 * std::numbers::pi;
     swept += d;
     prev = p;
   }
-  EXPECT_LE(worst_sag, 0.001 + 1e-12);
-  EXPECT_GT(worst_sag, 0.0005);  // not needlessly fine
+  EXPECT_LE(worst_in, 0.001 + 1e-12);
+  EXPECT_GT(worst_in, 0.0005);  // not needlessly fine
+  EXPECT_LE(worst_out, 0.001);
   EXPECT_NEAR(swept, c.sweep, 1e-9);
-  // Chord count: the smallest that meets the tolerance.
-  const double step = 2.0 * std::acos(1.0 - 0.001 / c.r);
-  EXPECT_EQ(static_cast<double>(pts.size()), std::ceil(std::abs(c.sweep) / step));
 }
 
 constexpr double kPi = std::numbers::pi;

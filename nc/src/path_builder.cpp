@@ -119,9 +119,13 @@ void PathBuilder::arc(int line, Plane p, const AxisVector& end, double cu, doubl
   }
   const double rmax = std::max(r0, r1);
   const double tol = opt_.chord_tol_mm;
-  // A chord of angle phi deviates r (1 - cos(phi / 2)) from the arc.
+  // Chords on both sides of the arc, like the kernel's two-sided polygons
+  // (docs/lbr-conventions.md): the inner vertices lie on radius r·θ/sin θ (θ half a chord's
+  // angle), which keeps the arc's mean position, so the swept volume has no bias from the
+  // chord tolerance; the end points stay exact. The end chords (from radius r to r·θ/sin θ)
+  // deviate most, about 5/12·r·θ² inside the arc: θ = sqrt(2.35·tol/r) keeps that below tol.
   double n_real = 1.0;
-  if (rmax > tol) n_real = std::ceil(std::abs(sweep) / (2.0 * std::acos(1.0 - tol / rmax)));
+  if (rmax > tol) n_real = std::ceil(std::abs(sweep) / (2.0 * std::sqrt(2.35 * tol / rmax)));
   if (!(n_real <= static_cast<double>(kMaxArcChords))) {
     std::ostringstream m;
     m << "arc of radius " << rmax << " mm needs more than " << kMaxArcChords << " chords at the chord tolerance "
@@ -129,6 +133,8 @@ void PathBuilder::arc(int line, Plane p, const AxisVector& end, double cu, doubl
     throw ParseError(tp_.source, line, m.str());
   }
   const long n = std::max(1L, static_cast<long>(n_real));
+  const double half = 0.5 * std::abs(sweep) / static_cast<double>(n);
+  const double grow = half > 1e-9 ? half / std::sin(half) : 1.0;
   double f = feed;
   if (inverse_time) {
     // Length of the linearised move, so that it takes 1/F minutes.
@@ -145,7 +151,7 @@ void PathBuilder::arc(int line, Plane p, const AxisVector& end, double cu, doubl
       const double k = static_cast<double>(i) / static_cast<double>(n);
       for (int a = 0; a < kAxes; ++a) q[a] = start[a] + k * (end[a] - start[a]);
       const double ang = a0 + k * sweep;
-      const double r = r0 + k * (r1 - r0);
+      const double r = (r0 + k * (r1 - r0)) * grow;
       q[ax.u] = cu + r * std::cos(ang);
       q[ax.v] = cv + r * std::sin(ang);
     }
