@@ -282,7 +282,7 @@ bool remove_slivers(Path& contour, const Rect& keep, double dist, Path& tmp) {
       }
       tmp.push_back(cur);
     }
-    contour.assign(tmp.begin(), tmp.end());  // (a swap would hand the cell the scratch buffer's capacity)
+    if (pass) contour.assign(tmp.begin(), tmp.end());  // (a swap would hand the cell the scratch buffer's capacity)
   }
   if (contour.size() < 3 && !contour.empty()) {
     contour.clear();
