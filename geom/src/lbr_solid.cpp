@@ -103,10 +103,10 @@ void LbrSolid::init_cells(bool fill) {
   dirty_flag_.assign(cells_.size(), 0);
   std::vector<double> region_area(static_cast<std::size_t>(regions()));
   const Path circle = stock_circle();
-  Path cut, tmp;  // stock_polygons' scratch, reused over the regions
+  Path cut, tmp, wedge;  // stock_polygons' scratch, reused over the regions
   for (int reg = 0; reg < regions(); ++reg) {
     Cell stock;
-    stock.polys = stock_polygons(reg, circle, cut, tmp);
+    stock.polys = stock_polygons(reg, circle, cut, tmp, wedge);
     detail::refresh_cell(stock);
     region_area[static_cast<std::size_t>(reg)] = stock.area_units2;
     for (int l = 0; fill && l < levels_; ++l) cells_[static_cast<std::size_t>(reg) * levels_ + l] = stock;
@@ -135,7 +135,7 @@ Path LbrSolid::stock_circle() const {
   return circle;
 }
 
-std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle, Path& cut, Path& tmp) const {
+std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle, Path& cut, Path& tmp, Path& wedge) const {
   const Rect rr = region_rect(reg);
   std::vector<Polygon> polys;
   if (spec_.shape == SolidSpec::Shape::Box) {
@@ -158,7 +158,7 @@ std::vector<Polygon> LbrSolid::stock_polygons(int reg, const Path& circle, Path&
         // Only the part of the outline near the region enters Clipper (cut_to_rect keeps it
         // vertex for vertex inside the region): a 4096-gon per region made a many-region
         // cylinder take seconds to build, and the levels file reader with it (fuzz_lbrs).
-        detail::cut_to_rect(circle, rr, cut, tmp);
+        detail::cut_to_rect(circle_near(rr, circle, wedge), rr, cut, tmp);
         ClipperLib::Clipper c;
         c.AddPath(cut, ClipperLib::ptSubject, true);
         c.AddPath(detail::rect_path(rr), ClipperLib::ptClip, true);
@@ -189,6 +189,41 @@ LbrSolid::CircleCover LbrSolid::circle_vs_rect(const Rect& rr, std::size_t segs)
   const double nx = std::max({x0, -x1, 0.0}), ny = std::max({y0, -y1, 0.0});  // nearest point
   if (std::hypot(nx, ny) >= rho + 2.0) return CircleCover::Outside;
   return CircleCover::Crossed;
+}
+
+// The part of the polygonised circle that can meet region rr: its vertices from one step
+// before the smallest angle of rr's corners to one step after the largest, closed through the
+// centre. The circle is star-shaped about its centre, so inside that sector the wedge and the
+// circle are the same set, and rr (at least 4 units off the wedge's radial sides) meets both
+// alike; cut_to_rect() then walks tens of vertices, not the whole outline per region (a
+// many-region cylinder made the levels file reader, fuzz_lbrs, spend 69 % of its time there).
+// The whole circle when rr is near the centre or the sector spans a quarter turn or more.
+const Path& LbrSolid::circle_near(const Rect& rr, const Path& circle, Path& wedge) const {
+  const std::size_t segs = circle.size();
+  if (segs < 8) return circle;
+  const CylinderStock& c = spec_.cylinder;
+  const double cx = c.center_x_mm * kUnitsPerMm, cy = c.center_y_mm * kUnitsPerMm;
+  const double x0 = static_cast<double>(rr.x0) - cx, x1 = static_cast<double>(rr.x1) - cx;
+  const double y0 = static_cast<double>(rr.y0) - cy, y1 = static_cast<double>(rr.y1) - cy;
+  const double step = 2.0 * std::numbers::pi / static_cast<double>(segs);
+  const double near = std::hypot(std::max({x0, -x1, 0.0}), std::max({y0, -y1, 0.0}));
+  if (near * std::sin(step) < 8.0) return circle;
+  const double mid = std::atan2(0.5 * (y0 + y1), 0.5 * (x0 + x1));
+  double lo = 0.0, hi = 0.0;
+  for (const double x : {x0, x1})
+    for (const double y : {y0, y1}) {
+      const double d = std::remainder(std::atan2(y, x) - mid, 2.0 * std::numbers::pi);
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+  const auto k0 = static_cast<long>(std::floor((mid + lo) / step)) - 1;
+  const auto k1 = static_cast<long>(std::ceil((mid + hi) / step)) + 1;
+  if (static_cast<double>(k1 - k0) * step >= 0.5 * std::numbers::pi) return circle;
+  wedge.clear();
+  wedge.push_back({to_units(c.center_x_mm), to_units(c.center_y_mm)});
+  const auto n = static_cast<long>(segs);
+  for (long k = k0; k <= k1; ++k) wedge.push_back(circle[static_cast<std::size_t>(((k % n) + n) % n)]);
+  return wedge;
 }
 
 double LbrSolid::level_bottom_mm(int level) const noexcept { return z0_ + level * spec_.level_spacing_mm; }

@@ -219,9 +219,11 @@ class LbrSolid {
   LbrSolid(const SolidSpec& spec, bool fill);
   void init_cells(bool fill);  // grid, initial volume; fill: every cell holds the stock
   [[nodiscard]] Path stock_circle() const;  // the cylinder polygonised (empty for a box)
-  [[nodiscard]] std::vector<Polygon> stock_polygons(int region, const Path& circle, Path& cut, Path& tmp) const;
+  [[nodiscard]] std::vector<Polygon> stock_polygons(int region, const Path& circle, Path& cut, Path& tmp,
+                                                   Path& wedge) const;
   enum class CircleCover { Inside, Outside, Crossed };  // a region against the cylinder's outline
   [[nodiscard]] CircleCover circle_vs_rect(const Rect& region, std::size_t segs) const noexcept;
+  [[nodiscard]] const Path& circle_near(const Rect& region, const Path& circle, Path& wedge) const;
 
   SolidSpec spec_;
   int levels_ = 0;
