@@ -219,4 +219,25 @@ TEST(LiveRealTime, CuttingTickAllocatesOnlyInsideTheKernel) {
   EXPECT_LE(cut_allocs, static_cast<long>(100 * cells)) << "allocations no longer bounded by the changed cells";
 }
 
+TEST(LiveOverload, ATimedTickStopsTakingSamplesAtItsWorkBudget) {
+  // Live sources (timed calls): a tick takes samples only while the sweeps they make are
+  // predicted to fit Geometry::kTickBudgetNs, the rest stay queued; later ticks apply them
+  // all. (A 5-axis stream far behind ran one tick of 35 s, then rested 50 s.)
+  GeometryRig rig;
+  rig.geo->set_timed_calls(true);
+  // A zig-zag cutting the stock: every sample ends a sweep of its own.
+  const std::size_t pushed = 3000;
+  for (std::size_t i = 0; i < pushed; ++i)
+    ASSERT_TRUE(rig.ring.try_push(sample(rig.seq++, 10.0 + 0.05 * static_cast<double>(i), 20.0 + (i % 2 ? 3.0 : 0.0), -1.0)));
+  const std::size_t first = rig.geo->tick(4096);
+  EXPECT_GT(first, 0u);
+  EXPECT_LT(first, pushed) << "one tick took the whole backlog";
+  EXPECT_EQ(rig.ring.size(), pushed - first) << "what a tick leaves stays queued";
+  std::size_t total = first, ticks = 1;
+  while (rig.ring.size() > 0 && ticks < 10000) total += rig.geo->tick(4096), ++ticks;
+  EXPECT_EQ(total, pushed);
+  EXPECT_EQ(rig.geo->applied(), pushed);
+  EXPECT_GT(ticks, 2u);
+}
+
 }  // namespace

@@ -12,3 +12,5 @@ target_include_directories(app_live_checks_test PRIVATE ${PROJECT_SOURCE_DIR}/ap
 # Emulator blending against exact stop through the kernel (docs/nc-frontend.md#planner).
 lbr_test(app_emulator_blend_test app_emulator_blend_test.cpp)
 target_compile_definitions(app_emulator_blend_test PRIVATE LBR_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+# The motion stream's merged runs, 5-axis included (geom::pose_deviation_mm).
+lbr_test(motion_sample_stream_test motion_sample_stream_test.cpp)

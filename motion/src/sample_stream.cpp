@@ -4,18 +4,6 @@
 
 namespace lbr::motion {
 
-namespace {
-
-// Distance of p from the segment a–b [mm].
-double dist_to_segment(geom::Vec3 p, geom::Vec3 a, geom::Vec3 b) noexcept {
-  const geom::Vec3 d = b - a;
-  const double dd = geom::dot(d, d);
-  const double t = dd > 0 ? std::clamp(geom::dot(p - a, d) / dd, 0.0, 1.0) : 0.0;
-  return geom::norm(p - geom::lerp(a, b, t));
-}
-
-}  // namespace
-
 SampleStream::SampleStream(const ToolTable& tools, const std::array<kin::Kinematics, kMaxChannels>& kins,
                            int default_tool, double tol_mm, std::size_t batch_capacity, SweepSink& sink)
     : tools_(tools), kins_(kins), default_tool_(tools.find(default_tool)), tol_(tol_mm), sink_(sink) {
@@ -104,13 +92,14 @@ void SampleStream::extend(Channel& c, const kin::Kinematics& k, const nc::AxisVe
   const geom::Pose p = kin::tool_pose(k, q, c.tool.mount, c.tool.length_mm);
   const bool step_fast = fast(c.run.back().tip, p.tip, dseq);
   if (c.run.size() >= 2) {
-    // Replace the run's straight sweep run[0]→last by run[0]→p only if the tool axis stays
-    // put, every sample of the run stays within the tolerance of the longer sweep and the
-    // step is of the run's kind (fast or not).
-    bool straight = c.run.size() < kMaxRun && p.axis == c.run[0].axis && c.run.back().axis == c.run[0].axis &&
-                    step_fast == c.run_fast;
+    // Replace the run's sweep run[0]→last by run[0]→p only if every sample of the run stays
+    // within the tolerance of the longer sweep (geom::pose_deviation_mm: with a fixed tool
+    // axis the tip's distance from the segment; while a rotary axis turns, also the turn of
+    // the axis times the tool's reach, so a 5-axis stream merges where its motion is close
+    // to linear) and the step is of the run's kind (fast or not).
+    bool straight = c.run.size() < kMaxRun && step_fast == c.run_fast;
     for (std::size_t i = 1; straight && i < c.run.size(); ++i)
-      straight = dist_to_segment(c.run[i].tip, c.run[0].tip, p.tip) <= tol_;
+      straight = geom::pose_deviation_mm(c.run[0], p, c.run[i], c.tool.reach_mm) <= tol_;
     if (!straight) flush(c);
   }
   if (c.run.size() == 1) c.run_first = c.seq, c.run_fast = step_fast;

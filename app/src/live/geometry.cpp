@@ -305,7 +305,9 @@ std::size_t Geometry::tick(std::size_t limit) {
   lag_done_ = 0;
   done_any_ = {};
   limit = std::min(limit, rx_.size());
-  while (n < limit) {
+  tick_units_ = 0.0;
+  const double tick_budget = timed_ ? sizer_.budget_units(kTickBudgetNs) : INFINITY;
+  while (n < limit && tick_units_ < tick_budget) {
     hal::AxisSample* s = ring_.front();
     if (s == nullptr) break;
     rx_[n] = s->t_rx_ns;  // before take(): a full motion batch is applied (and checked) inside it
@@ -356,6 +358,7 @@ std::uint64_t Geometry::discard() noexcept {
 
 void Geometry::on_sweep(const geom::SweepRef& s) noexcept {
   if (ex_ != nullptr) ex_->add_path_point(s.to.tip);
+  if (timed_) tick_units_ += work_units(s);
 }
 
 void Geometry::on_batch_full(std::span<const geom::SweepRef> batch) noexcept {

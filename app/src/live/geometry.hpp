@@ -57,7 +57,12 @@ class Geometry final : public motion::SweepSink {
   [[nodiscard]] static std::size_t batch_capacity(std::size_t ring_capacity) noexcept;
 
   // Applies what is in the ring, at most `limit` ring entries; returns the entries taken.
+  // With timed calls (live sources) a tick also stops taking entries once the sweeps they
+  // made are predicted to take kTickBudgetNs: what is left stays queued (and merges further)
+  // for the next tick, so the thread returns to the pipeline (display, snapshot, stop, duty
+  // rest) every few calls however far behind it is.
   std::size_t tick(std::size_t limit);
+  static constexpr std::int64_t kTickBudgetNs = 100'000'000;
 
   // Stop handling: `a` or `b` set asks for a stop; the first kernel-call boundary that sees
   // it stores the time in `*stop_ns` (unless another thread did), and from stop_ns + grace
@@ -193,6 +198,7 @@ class Geometry final : public motion::SweepSink {
   bool timed_ = false;
   CallSizer sizer_;
   std::vector<double> prefix_units_;  // sub_batch(): units of its first k + 1 sweeps
+  double tick_units_ = 0.0;           // work units of the sweeps made in this tick so far
   std::size_t lag_done_ = 0;  // ring entries of this tick whose lag is recorded
   std::array<std::uint64_t, hal::kMaxChannels> done_seq_{};  // per channel: applied up to this sample
   std::array<bool, hal::kMaxChannels> done_any_{};

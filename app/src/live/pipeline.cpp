@@ -173,13 +173,17 @@ gfx::LiveStats live_stats(const LivePipeline::Impl& p) {
 // workload at 1 kHz without a limit. The bank bounds the work of any second by
 // kDutyBurstNs + duty·1 s (0.9 s at the default 0.7), and a single long tick no longer
 // forces a rest (before: w·(1/duty − 1) after every tick, which added up to 43 % of each
-// long call to the lag of the samples queued behind it).
+// long call to the lag of the samples queued behind it). The debt is also bounded by
+// kDutyBurstNs, so no rest is longer than kDutyBurstNs / duty (0.29 s): a tick of 35 s (a
+// 5-axis stream far behind, before ticks had a budget: Geometry::kTickBudgetNs) was followed
+// by a 50-s rest while the ring filled. A rest ends early when a stop is asked for.
 //
 // Stop (docs/architecture.md "Live overload"): after a stop request the thread goes on
 // applying what is queued for kStopGraceNs, then abandons the rest (counted as
 // samples_unapplied) — checked between kernel calls, whose work the budget bounds.
 constexpr std::int64_t kStopGraceNs = 250'000'000;
 constexpr std::int64_t kDutyBurstNs = 200'000'000;
+constexpr std::int64_t kRestSliceNs = 20'000'000;
 
 // Gathering (live sources): a kernel call pays a fixed cost for every cell it clips, so a
 // thread that applies each sample as soon as it arrives spends most of its time re-clipping
@@ -261,6 +265,13 @@ void gather(LivePipeline::Impl& p, double tick_ewma_ns) noexcept {
   if (due > sched::now_ns() && !stop_asked(p)) sched::sleep_until_ns(due);
 }
 
+// The duty rest: sleeps until `due` in slices of kRestSliceNs, and returns early when a stop
+// is asked for (a stop takes effect within a slice, not after the rest).
+void rest_until(const LivePipeline::Impl& p, std::int64_t due) noexcept {
+  for (std::int64_t now = sched::now_ns(); now < due && !stop_asked(p); now = sched::now_ns())
+    sched::sleep_until_ns(std::min(due, now + kRestSliceNs));
+}
+
 void geometry_thread(LivePipeline::Impl& p) {
   const hal::LiveConfig& cfg = p.profile.live;
   p.geo_mode = sched::configure_current_thread(cfg.geometry_thread) == sched::RtMode::Fifo ? 1 : 0;
@@ -286,11 +297,12 @@ void geometry_thread(LivePipeline::Impl& p) {
       offer_snapshot(p, snapshot_due_ns);
       if (duty_limited && !finished) {
         const std::int64_t now = sched::now_ns();
-        credit_ns = std::min(static_cast<double>(kDutyBurstNs),
-                             credit_ns + cfg.geometry_duty * static_cast<double>(now - t_credit)) -
-                    static_cast<double>(now - t_tick);
+        credit_ns = std::max(-static_cast<double>(kDutyBurstNs),
+                             std::min(static_cast<double>(kDutyBurstNs),
+                                      credit_ns + cfg.geometry_duty * static_cast<double>(now - t_credit)) -
+                                 static_cast<double>(now - t_tick));
         t_credit = now;
-        if (credit_ns < 0.0) sched::sleep_until_ns(now + static_cast<std::int64_t>(-credit_ns / cfg.geometry_duty));
+        if (credit_ns < 0.0) rest_until(p, now + static_cast<std::int64_t>(-credit_ns / cfg.geometry_duty));
       }
       continue;
     }

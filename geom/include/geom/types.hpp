@@ -42,6 +42,26 @@ struct Pose {
   Vec3 axis{0, 0, 1};
 };
 
+// How far the tool at pose p lies from the sweep a→b (tip along the segment, axis
+// normalized(lerp(a.axis, b.axis, t)), as geom::Sweep moves it) [mm]: at the parameter t where
+// p's tip projects onto the segment, the tips' distance plus reach_mm times the angle between
+// the axes. A rigid motion taking that sweep pose to p moves no tool point within reach_mm of
+// the tip farther (a turn by the angle, then the tips' offset), so it bounds the distance of
+// every cutting point of a rotationally symmetric tool. With a fixed axis it is the tip's
+// distance from the segment. The test of the live stream's merged runs (motion::SampleStream).
+[[nodiscard]] inline double pose_deviation_mm(const Pose& a, const Pose& b, const Pose& p, double reach_mm) noexcept {
+  const Vec3 d = b.tip - a.tip;
+  const double dd = dot(d, d);
+  const double t = dd > 0 ? std::clamp(dot(p.tip - a.tip, d) / dd, 0.0, 1.0) : 0.0;
+  const double off = norm(p.tip - lerp(a.tip, b.tip, t));
+  if (a.axis == b.axis && p.axis == a.axis) return off;
+  const Vec3 m = lerp(a.axis, b.axis, t);
+  const double len = norm(m);
+  if (!(len > 0.0)) return std::numeric_limits<double>::infinity();
+  const double chord = norm(p.axis - (1.0 / len) * m);  // between unit vectors: 2 sin(angle / 2)
+  return off + reach_mm * 2.0 * std::asin(std::min(1.0, 0.5 * chord));
+}
+
 // Axis-aligned box in mm.
 struct Box3 {
   Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),

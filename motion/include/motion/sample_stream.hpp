@@ -1,10 +1,12 @@
 // motion/sample_stream.hpp — live axis samples → sweeps, per channel, merging straight runs.
 //
 // The live geometry thread (app/src/live/) feeds every sample it takes from the ring. Each
-// channel keeps a pending run: consecutive samples extend one sweep while the tool axis stays
-// put and every merged sample stays within `tol_mm` of the longer sweep (geometry stays
-// exact, docs/architecture.md); a move that turns a rotary axis is cut into chords
-// (kin::substeps) instead. Finished sweeps go into a batch buffer the caller subtracts.
+// channel keeps a pending run: consecutive samples extend one sweep while every merged
+// sample's tool stays within `tol_mm` of the longer sweep (geom::pose_deviation_mm: the tip's
+// offset, plus the tool axis's turn times the tool's reach while a rotary axis moves; geometry
+// stays exact, docs/architecture.md); a single step that turns a rotary axis too far for one
+// chord is cut into chords (kin::substeps) instead. Finished sweeps go into a batch buffer
+// the caller subtracts.
 //
 // Rapid steps (live collision checks, docs/verification.md#live): with set_fast_step(), a
 // step from one sample to the next is fast when the tip moves farther than the threshold
