@@ -161,3 +161,30 @@ TEST(Volume, TiltedFlatPlungeLeavesTheEllipticalFootprint) {
   const double exact = test::kPi * 25.0 * 6.0 / std::cos(th);
   EXPECT_NEAR(test::removed(s), exact, 0.002 * exact);
 }
+
+TEST(Volume, SampledTiltingPassMergesIntoTheSweepItSamples) {
+  // A ball pass whose tool axis tilts from +Z to 20 degrees about X, sampled as 400 short
+  // sweeps on the pose path of the single sweep from start to end: the batch merges them
+  // (merge_collinear's tilted runs, at most 64 sweeps each) and removes what the single
+  // sweep removes. Before, each sampled sweep was sectioned on its own (400x the sections).
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  const double th = 20.0 * test::kPi / 180.0;
+  const geom::Pose a = test::at(10, 20, -3), b = test::at(50, 20, -3, {0, -std::sin(th), std::cos(th)});
+  geom::LbrSolid one(test::box_spec({0, 0, -20}, {60, 40, 0}, 0.1));
+  const geom::SubtractStats single = test::cut(one, c, a, b);
+  std::vector<geom::SweepRef> fine;
+  geom::Pose from = a;
+  for (int k = 1; k <= 400; ++k) {
+    const double t = k / 400.0;
+    const geom::Vec3 m = geom::lerp(a.axis, b.axis, t);
+    const geom::Pose to = k == 400 ? b : geom::Pose{geom::lerp(a.tip, b.tip, t), (1.0 / geom::norm(m)) * m};
+    fine.push_back({&c, from, to, static_cast<geom::MoveId>(k)});
+    from = to;
+  }
+  geom::LbrSolid sampled(test::box_spec({0, 0, -20}, {60, 40, 0}, 0.1));
+  const geom::SubtractStats st = sampled.subtract(fine);
+  EXPECT_LE(st.sections, 8 * single.sections) << st.sections << " sections against " << single.sections;
+  EXPECT_NEAR(test::removed(sampled), test::removed(one), 1e-4 * test::removed(one));
+  EXPECT_GT(test::removed(one), 500.0);
+  EXPECT_EQ(sampled.check_invariants(), "");
+}

@@ -33,6 +33,32 @@ double dist_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) noexcept {
   return norm(p - (a + t * ab));
 }
 
+// A run of milling sweeps from batch[i] whose tool axis turns (a sampled 5-axis stream):
+// extended while the next sweep continues the run with the same tool and every pose inside
+// the run (the ends of its sweeps) stays within tol of the merged sweep by
+// geom::pose_deviation_mm with the tool's reach (its profile's farthest point from the tip):
+// the rule of the live stream (motion::SampleStream). O(run) per sweep, so runs stop at
+// kMaxTiltedRun. Returns the end of the run; `merged` is its sweep.
+std::size_t merge_tilted_run(std::span<const SweepRef> batch, std::size_t i, double tol, SweepRef& merged) noexcept {
+  constexpr std::size_t kMaxTiltedRun = 64;
+  const SweepRef& first = batch[i];
+  const double reach = std::hypot(first.shape->height(), first.shape->radius());
+  merged = first;
+  std::size_t j = i + 1;
+  for (; j < batch.size() && j - i < kMaxTiltedRun; ++j) {
+    const SweepRef& n = batch[j];
+    if (n.shape != first.shape || n.turning != nullptr || !(n.from.tip == merged.to.tip) ||
+        !same_axis(n.from.axis, merged.to.axis))
+      break;
+    bool within = true;
+    for (std::size_t k = i; within && k < j; ++k) within = pose_deviation_mm(first.from, n.to, batch[k].to, reach) <= tol;
+    if (!within) break;
+    merged.to = n.to;
+    merged.id = std::max(merged.id, n.id);
+  }
+  return j;
+}
+
 }  // namespace
 
 void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out) {
@@ -47,6 +73,11 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
     }
     SweepRef merged = first;
     const double tol = 0.5 * (first.shape != nullptr ? first.shape->chord_tol_mm : first.turning->chord_tol_mm);
+    if (first.shape != nullptr && !same_axis(first.from.axis, first.to.axis)) {
+      i = merge_tilted_run(batch, i, tol, merged);
+      out.push_back(merged);
+      continue;
+    }
     std::size_t j = i + 1;
     // Extend the run while the next move continues this one with the same tool and a fixed
     // axis, and every intermediate point stays within tol/2 of the merged chord.

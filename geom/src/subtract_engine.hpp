@@ -87,7 +87,9 @@ class SubtractEngine {
 // Merges runs of consecutive moves of one tool with a fixed axis into single moves when no
 // intermediate point lies farther than half the chord tolerance from the merged chord (so the
 // swept region moves by at most that much). The merged move keeps the largest move id.
-// Sampled straight lines collapse to one move each. Allocates only when `out` grows.
+// Sampled straight lines collapse to one move each. Runs whose tool axis turns merge while
+// every pose inside stays within that of the merged move, rotation times the tool's reach
+// included (geom::pose_deviation_mm). Allocates only when `out` grows.
 void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out);
 
 // Builds offset `o` of the prepared batch (sh.offsets[o].paths). Allocates (Clipper).
