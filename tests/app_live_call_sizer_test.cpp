@@ -15,6 +15,7 @@
 
 using lbr::app::live::CallSizer;
 using lbr::app::live::CallSizerConfig;
+using lbr::app::live::DutyBank;
 
 namespace {
 
@@ -164,4 +165,41 @@ TEST(CallSizer, LongerCallsWhenBehindKeepThroughputAboveRealTime) {
   for (const Call& k : sim.calls) most = std::max(most, k.samples);
   EXPECT_GE(most, 3u) << "behind, calls must take several samples";
   EXPECT_LE(percentile(sim.lag_ns, 0.99), 15'000'000);
+}
+
+TEST(DutyBank, ShortTicksWithinTheDutyNeverRest) {
+  DutyBank bank(0.7, 200'000'000, 0);
+  std::int64_t t = 0;
+  for (int i = 0; i < 1000; ++i) {  // 1 ms of work every 2 ms: 50 % < 70 %
+    EXPECT_EQ(bank.spend(t, t + 1'000'000), 0);
+    t += 2'000'000;
+  }
+  EXPECT_DOUBLE_EQ(bank.credit_ns(), 199'000'000.0);  // full (0.2 s) less the last tick's work
+}
+
+TEST(DutyBank, SteadyOverloadRestsToHoldTheDuty) {
+  DutyBank bank(0.5, 200'000'000, 0);
+  std::int64_t t = 0, t_half = 0;
+  int rests = 0;
+  for (int i = 0; i < 400; ++i) {  // 10-ms ticks back to back, resting as told
+    if (i == 200) t_half = t;
+    const std::int64_t end = t + 10'000'000;
+    const std::int64_t rest = bank.spend(t, end);
+    rests += rest > 0;
+    t = end + rest;
+  }
+  // The banked 0.2 s goes first (the first tick spends 10 ms of a full bank, then a net 5 ms
+  // each: 39 ticks without a rest), then work : wall = duty.
+  EXPECT_EQ(rests, 400 - 39);
+  EXPECT_NEAR(200 * 10e6 / static_cast<double>(t - t_half), 0.5, 1e-6);
+}
+
+TEST(DutyBank, ALongTickRestsAtMostTheBurstOverTheDuty) {
+  // A 35-s tick (a 5-axis stream far behind, before ticks had a budget) used to be followed
+  // by a rest of (35 − 0.2) / 0.7 = 50 s while the ring filled; the debt is capped now.
+  DutyBank bank(0.7, 200'000'000, 0);
+  const std::int64_t rest = bank.spend(0, 35'000'000'000);
+  EXPECT_GT(rest, 0);
+  EXPECT_LE(rest, static_cast<std::int64_t>(200'000'000 / 0.7) + 1);
+  EXPECT_DOUBLE_EQ(bank.credit_ns(), -200'000'000.0);
 }

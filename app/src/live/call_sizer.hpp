@@ -22,6 +22,8 @@
 // Real-time safe: no allocation, no exceptions, no locks; the clock is the caller's.
 #pragma once
 
+#include <algorithm>
+
 #include <cstdint>
 
 namespace lbr::app::live {
@@ -60,6 +62,28 @@ class CallSizer {
  private:
   CallSizerConfig c_;
   double ns_per_unit_;
+};
+
+// The geometry thread's duty limit (pipeline.cpp, "Duty limit"): it earns `duty` seconds of
+// work per second of wall time, banked up to `burst_ns`, and spends each tick's work; when
+// overdrawn it rests until even. The debt is bounded by `burst_ns` too, so no rest is longer
+// than burst_ns / duty however long the tick was.
+class DutyBank {
+ public:
+  DutyBank(double duty, std::int64_t burst_ns, std::int64_t now_ns) noexcept
+      : duty_(duty), burst_(static_cast<double>(burst_ns)), credit_(static_cast<double>(burst_ns)), t_(now_ns) {}
+  // A tick worked from `t_tick_ns` to `now_ns`: the rest it calls for [ns] (0: none).
+  [[nodiscard]] std::int64_t spend(std::int64_t t_tick_ns, std::int64_t now_ns) noexcept {
+    const double earned = std::min(burst_, credit_ + duty_ * static_cast<double>(now_ns - t_));
+    credit_ = std::max(-burst_, earned - static_cast<double>(now_ns - t_tick_ns));
+    t_ = now_ns;
+    return credit_ < 0.0 ? static_cast<std::int64_t>(-credit_ / duty_) : 0;
+  }
+  [[nodiscard]] double credit_ns() const noexcept { return credit_; }
+
+ private:
+  double duty_, burst_, credit_;
+  std::int64_t t_;
 };
 
 }  // namespace lbr::app::live

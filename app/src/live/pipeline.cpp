@@ -164,8 +164,9 @@ gfx::LiveStats live_stats(const LivePipeline::Impl& p) {
 // that are not live (replay/emulator as fast as possible) are applied in chunks of exactly
 // lbr.batch_moves samples, so such a run is reproducible bit for bit.
 //
-// Duty limit: a live source's geometry thread earns `duty` seconds of work per second of
-// wall time, banked up to kDutyBurstNs, and spends its work on it; when the bank is
+// Duty limit (live::DutyBank, call_sizer.hpp): a live source's geometry thread earns `duty`
+// seconds of work per second of wall time, banked up to kDutyBurstNs, and spends its work
+// on it; when the bank is
 // overdrawn it rests until it is even (samples queue meanwhile and merge into longer
 // sweeps). A SCHED_FIFO thread that keeps a core busy trips the kernel's real-time
 // throttling (sched_rt_runtime_us, by default 950 ms per second), which then stops it for
@@ -278,8 +279,7 @@ void geometry_thread(LivePipeline::Impl& p) {
   const std::size_t chunk = p.backpressure ? static_cast<std::size_t>(p.profile.batch_moves) : p.ring->capacity();
   const std::int64_t idle_ns = static_cast<std::int64_t>(cfg.geometry_idle_us) * 1000;
   const bool duty_limited = !p.backpressure && cfg.geometry_duty < 1.0;
-  double credit_ns = static_cast<double>(kDutyBurstNs);
-  std::int64_t t_credit = sched::now_ns();
+  live::DutyBank duty(cfg.geometry_duty, kDutyBurstNs, sched::now_ns());
   double tick_ewma_ns = 0.0;
   std::int64_t snapshot_due_ns = sched::now_ns() + p.snapshot_period_ns;
   p.progress->geometry_running.store(true, std::memory_order_relaxed);
@@ -297,12 +297,7 @@ void geometry_thread(LivePipeline::Impl& p) {
       offer_snapshot(p, snapshot_due_ns);
       if (duty_limited && !finished) {
         const std::int64_t now = sched::now_ns();
-        credit_ns = std::max(-static_cast<double>(kDutyBurstNs),
-                             std::min(static_cast<double>(kDutyBurstNs),
-                                      credit_ns + cfg.geometry_duty * static_cast<double>(now - t_credit)) -
-                                 static_cast<double>(now - t_tick));
-        t_credit = now;
-        if (credit_ns < 0.0) rest_until(p, now + static_cast<std::int64_t>(-credit_ns / cfg.geometry_duty));
+        if (const std::int64_t rest = duty.spend(t_tick, now); rest > 0) rest_until(p, now + rest);
       }
       continue;
     }
