@@ -340,4 +340,13 @@ TEST(NgcCutterComp, GougingCornersAreRefusedWithTheLine) {
   EXPECT_EQ(error_of("G19 G41 D1\n", mill_with_tools()), "t.ngc:1: cutter radius compensation needs plane G17 (XY) or G18 (XZ)");
 }
 
+TEST(NgcCutterComp, RegressionAMoveStillHeldAtTheEndIsNamedAtTheLastLine) {
+  // fuzz_gcode (seventh round): a program that ends with compensation on and no M2. The move
+  // compensation still held went out when the program ran off its end, and its gouge error
+  // named line 4 of a 3-line program.
+  // Its input, as found (fuzz/corpus/gcode/regression-comp-at-end):
+  EXPECT_EQ(error_of("%SIA\xa8" "6\nD1G0X1G41.1\nG0 ^40 81T32104", mill_with_tools()),
+            "t.ngc:3: straight traverse in a concave corner cannot be reached by the tool (radius 0.5 mm) without gouging");
+}
+
 }  // namespace

@@ -230,7 +230,13 @@ ControlFlow::ControlFlow(Params& params, const GcodeOptions& options, Executor e
     : params_(params), opt_(options), exec_(std::move(exec)), expr_(params) {}
 
 const std::string& ControlFlow::file() const { return stack_.back().file->path; }
-int ControlFlow::line() const { return static_cast<int>(stack_.back().pc) + 1; }
+int ControlFlow::line() const {
+  // Past the end (the program ran off its last line without M2): what fails then, e.g. the
+  // move that cutter compensation still holds, is named at the last line, not one after it.
+  const Activation& a = stack_.back();
+  const std::size_t n = a.file->lines.size();
+  return static_cast<int>(n > 0 ? std::min(a.pc, n - 1) : 0) + 1;
+}
 int ControlFlow::main_line() const {
   for (auto it = stack_.rbegin(); it != stack_.rend(); ++it)
     if (it->file == files_.front().get()) return static_cast<int>(it->pc) + 1;
