@@ -286,6 +286,23 @@ TEST(FanucDialect, M99InTheMainProgramEndsIt) {
   ASSERT_EQ(e.size(), 1u);
 }
 
+TEST(FanucDialect, RegressionLoopOfLargeArcsIsRefusedNotOutOfMemory) {
+  // fuzz_gcode (campaign 2026-11-28): an endless GOTO loop of arcs whose centre words read
+  // I-42000 and I-48000 (blanks are removed before parsing) made ~9 000 chords each per
+  // pass; within 20 000 blocks that was 2.5 GB of toolpath before libFuzzer's memory limit
+  // (fuzz/corpus/gcode/regression-arc-loop-oom). The toolpath is bounded instead.
+  const std::string prog =
+      "N1M8 G94 G40 G49 G80\nT0 G40\nF800\nG3 X24 Y28 Z0.0357 I-4 2000 M3\nG0 X32 Y+8 Z0 G40\nF800\n"
+      "G3 I-4 8000\nG3 X24 Y28 Z0.0357 I-4 2000 M3\nG0 X32 Y+81M64P0 \nGOTO1\n";
+  GcodeOptions o = fanuc();
+  o.chord_tol_mm = 0.01;
+  o.max_blocks = 20000;
+  o.max_segments = 100000;
+  EXPECT_EQ(error_of(prog, o),
+            "t.nc:7: the program makes more than 100000 moves (an endless loop, or arcs of many turns at a fine chord "
+            "tolerance?)");
+}
+
 // Seeded random mutations of Fanuc programs: every run ends in a Toolpath or a ParseError naming
 // a line of the input, never in another exception, a crash or a hang. LBR_FUZZ_SEED=<n>
 // reproduces a run; the budget is a few seconds.
@@ -301,7 +318,8 @@ TEST(FanucDialect, SeededMutatorNeverCrashesOrHangs) {
   const std::string alphabet = "GMXYZPLKOND#[]=0123456789.-+ ()%;/\nIFWHILEDOENDGOTOTHEN";
   GcodeOptions o = fanuc();
   o.chord_tol_mm = 0.01;
-  o.max_blocks = 20000;  // mutated loops may never end
+  o.max_blocks = 20000;      // mutated loops may never end
+  o.max_segments = 100000;  // nor may loops of large arcs (see the regression below)
   const auto t0 = std::chrono::steady_clock::now();
   int runs = 0, parsed = 0;
   for (; runs < 20000; ++runs) {

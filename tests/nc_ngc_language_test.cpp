@@ -137,6 +137,22 @@ TEST(NgcControl, EndlessLoopIsBoundedAndMismatchesAreNamed) {
   EXPECT_EQ(error_of("G0 X1\no<nosuch> call\n").find("t.ngc:2: subroutine o<nosuch> is not defined"), 0u);
 }
 
+TEST(NgcControl, ToolpathSizeIsBoundedAndTheLineNamed) {
+  GcodeOptions o;
+  o.max_segments = 3;
+  EXPECT_EQ(run("G0 X1\nG0 X2\nG0 X3\n", o).segments.size(), 3u);  // at the limit: accepted
+  EXPECT_EQ(error_of("G0 X1\nG0 X2\nG0 X3\nG0 X4\n", o),
+            "t.ngc:4: the program makes more than 3 moves (an endless loop, or arcs of many turns at a fine chord "
+            "tolerance?)");
+  // Ten turns of r = 50 mm at 1 um: 4 583 chords, refused in the arc's own line.
+  o.max_segments = 1000;
+  EXPECT_EQ(error_of("F100\nG2 X0 Y0 I-50 J0 P10\n", o),
+            "t.ngc:2: the program makes more than 1000 moves (an endless loop, or arcs of many turns at a fine chord "
+            "tolerance?)");
+  o.max_segments = 5000;
+  EXPECT_EQ(run("F100\nG2 X0 Y0 I-50 J0 P10\n", o).segments.size(), 4583u);
+}
+
 TEST_F(NgcFiles, SubroutineFileFromTheProgramDirectoryAndTheSearchPath) {
   write("lib/side.ngc", "o<side> sub\nG1 X[#1] F100\no<side> endsub\nM2\n");
   write("square.ngc", "o<square> sub\no<side> call [#1]\nG1 Y[#1]\no<square> endsub\n");

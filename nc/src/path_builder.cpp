@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <string>
 
 namespace lbr::nc::detail {
 
@@ -63,6 +64,10 @@ AxisVector PathBuilder::tip(const AxisVector& p) const {
 }
 
 void PathBuilder::push(SegmentKind k, int line, const AxisVector& end_program, double feed_mm_per_min, double dwell_s) {
+  if (opt_.max_segments > 0 && tp_.segments.size() >= static_cast<std::size_t>(opt_.max_segments))
+    throw ParseError(tp_.source, line,
+                     "the program makes more than " + std::to_string(opt_.max_segments) +
+                         " moves (an endless loop, or arcs of many turns at a fine chord tolerance?)");
   Segment s;
   s.kind = k;
   s.end = tip(end_program);

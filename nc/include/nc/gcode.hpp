@@ -58,6 +58,10 @@ struct GcodeOptions {
   std::array<bool, 3> rotary{true, true, true};
   // At most this many blocks are executed (loops included); more is an error, not a hang. 0: no limit.
   long max_blocks = 20000000;
+  // At most this many toolpath segments (moves, arc chords, dwells, tool changes) are made;
+  // more is an error naming the line, not an exhausted memory (a short loop of large arcs
+  // or many turns makes millions of chords per pass: ~150 bytes each). 0: no limit.
+  long max_segments = 20000000;
 };
 
 // Interprets G-code text. `name` is used in messages and as Toolpath::source. Arcs become
