@@ -60,7 +60,7 @@ struct GcodeOptions {
   long max_blocks = 20000000;
   // At most this many toolpath segments (moves, arc chords, dwells, tool changes) are made;
   // more is an error naming the line, not an exhausted memory (a short loop of large arcs
-  // or many turns makes millions of chords per pass: ~150 bytes each). 0: no limit.
+  // or many turns makes millions of chords per pass: 152 bytes each). 0: no limit.
   long max_segments = 20000000;
 };
 
