@@ -11,7 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.chord_tol_mm = 0.01;
   // A few ARC_FEED lines of many turns or a huge radius make up to 10^6 chords each: the
   // toolpath is bounded as in fuzz_gcode, so such an input is an error, not an out-of-memory.
-  o.max_segments = 100000;
+  o.max_segments = 20000;
   try {
     (void)lbr::nc::parse_rs274_canon(text, "fuzz.canon", o);
   } catch (const lbr::nc::ParseError&) {
