@@ -22,7 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // campaigns' "slow units"); the refusal path is the same at any count.
     o.max_blocks = 20000;
     // And a loop of large arcs is refused after this many segments, not an out-of-memory
-    // (campaign 2026-11-28: a Fanuc GOTO loop of arcs with I-48000 reached 2.5 GB). The refusal
+    // (campaign 2026-11-28: a Fanuc GOTO loop of a full circle with I-48000 reached 2.5 GB). The refusal
     // path is the same at any count.
     o.max_segments = 20000;
     try {

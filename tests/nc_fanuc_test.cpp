@@ -287,10 +287,10 @@ TEST(FanucDialect, M99InTheMainProgramEndsIt) {
 }
 
 TEST(FanucDialect, RegressionLoopOfLargeArcsIsRefusedNotOutOfMemory) {
-  // fuzz_gcode (campaign 2026-11-28): an endless GOTO loop of arcs whose centre words read
-  // I-42000 and I-48000 (blanks are removed before parsing) made ~9 000 chords each per
-  // pass; within 20 000 blocks that was 2.5 GB of toolpath before libFuzzer's memory limit
-  // (fuzz/corpus/gcode/regression-arc-loop-oom). The toolpath is bounded instead.
+  // fuzz_gcode (campaign 2026-11-28): an endless GOTO loop whose full circle `G3 I-4 8000`
+  // reads I-48000 (blanks are removed before parsing) made 4 494 segments per pass; within
+  // 20 000 blocks the toolpath vector grew to a 2.5 GB allocation, over libFuzzer's memory
+  // limit (fuzz/corpus/gcode/regression-arc-loop-oom). The toolpath is bounded instead.
   const std::string prog =
       "N1M8 G94 G40 G49 G80\nT0 G40\nF800\nG3 X24 Y28 Z0.0357 I-4 2000 M3\nG0 X32 Y+8 Z0 G40\nF800\n"
       "G3 I-4 8000\nG3 X24 Y28 Z0.0357 I-4 2000 M3\nG0 X32 Y+81M64P0 \nGOTO1\n";
