@@ -163,9 +163,21 @@ TEST(DesignCompare, AnOverCutPassIsMeasuredAndLocated) {
   app::Profile p = app::default_profile();
   p.design = {stl, 0.02};
   const std::string json = app::batch_metrics_json(r, p, "slot.ngc");
-  for (const char* key : {"\"design_gouge_mm3\": 150.", "\"design_excess_mm3\"", "\"max_gouge_mm\": 0.30",
-                          "\"max_gouge_line\": 20", "\"max_gouge_at_mm\""})
+  for (const char* key : {"\"design_gouge_mm3\"", "\"design_excess_mm3\"", "\"max_gouge_mm\"", "\"max_gouge_line\": 20",
+                          "\"max_gouge_at_mm\""})
     EXPECT_NE(json.find(key), std::string::npos) << key;
+  // The values as written (the wall at Y60.3 is exact: 0.3 mm deep, 150 mm3).
+  const nlohmann::json m = nlohmann::json::parse(json);
+  const auto find = [&](const char* key) -> const nlohmann::json& {
+    for (const auto& [k, v] : m.items())
+      if (k == key) return v;
+    for (const auto& [k, v] : m.items())
+      if (v.is_object() && v.contains(key)) return v.at(key);
+    ADD_FAILURE() << key << " not in metrics.json";
+    return m;
+  };
+  EXPECT_NEAR(find("design_gouge_mm3").get<double>(), expected, 0.02 * expected);
+  EXPECT_NEAR(find("max_gouge_mm").get<double>(), 0.3, 0.001);
 }
 
 // Regression (fuzz_stl): NaN, infinite and huge coordinates were accepted and reached the

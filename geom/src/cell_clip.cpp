@@ -95,9 +95,13 @@ void drop_slivers(const Rect& rr, SubtractWorkspace& ws) {
 }
 
 // A difference that removes no more than the rounding of intersection points to the unit
-// grid can account for (half a unit along the touched perimeter) is noise, e.g. a second
-// pass along the same path: the caller keeps the old polygons, vertex for vertex.
+// grid can account for (half a unit along the touched perimeter), and keeps as many
+// polygons, is noise, e.g. a second pass along the same path: the caller keeps the old
+// polygons, vertex for vertex. A polygon that vanishes is not noise, however thin: a strip
+// one unit wide (left where a section's side is tangent to a stock face) would otherwise
+// stay for good, since its whole area is below that bound.
 bool removes_only_noise(const Cell& cell, const SubtractWorkspace& ws) {
+  if (ws.fresh.size() != ws.touched.size()) return false;
   double before = 0.0, after = 0.0, perimeter = 0.0;
   for (std::uint32_t p : ws.touched) {
     const Polygon& old = cell.polys[p];
