@@ -182,3 +182,30 @@ TEST(Solid, ChainOffsetBoxOnARegionBoundary) {
     EXPECT_GT(chained.initial_volume_mm3() - chained.volume_mm3(), 5.0 * (10.6 * 8.0 + 32.0 * test::kPi)) << k;  // > a stadium and the hole
   }
 }
+
+// Regression: a clip whose result loses a whole polygon is a change, however thin that
+// polygon. A strip one unit wide along a stock face (left where a section's side is tangent
+// to the face) has less area than half a unit times its perimeter, the bound under which a
+// difference counts as rounding noise, and used to stay for good: every later pass over it
+// was taken for noise and its cells kept.
+TEST(LbrSolid, RegressionAStripOneUnitWideIsRemovedByAPassOverIt) {
+  geom::SolidSpec spec;
+  spec.box = {{0, 0, 0}, {20, 16, 6}};
+  spec.level_spacing_mm = 0.1;
+  spec.regions_x = spec.regions_y = 1;
+  geom::LbrSolid s(spec);
+  const int level = 57;
+  geom::Polygon strip;
+  strip.outer.pts = {{geom::to_units(20.0), geom::to_units(16.0)}, {0, geom::to_units(16.0)},
+                     {0, geom::to_units(16.0) - 1}, {geom::to_units(20.0), geom::to_units(16.0) - 1}};
+  strip.bbox = geom::bounds_of(strip.outer.pts);
+  for (int l = 0; l < s.levels(); ++l) s.set_cell(0, l, l == level ? std::vector<geom::Polygon>{strip} : std::vector<geom::Polygon>{});
+  ASSERT_FALSE(s.cell(0, level).bbox.empty());
+  geom::Tool t;
+  t.diameter_mm = 6.0;
+  const geom::CutterShape flat = geom::CutterShape::build(t, 0.001);
+  const geom::SweepRef ref{&flat, geom::Pose{{-4, 14, 2}}, geom::Pose{{24, 14, 2}}, 1};  // covers y 11..17 on every level above z 2
+  const geom::SubtractStats st = s.subtract(std::span<const geom::SweepRef>(&ref, 1));
+  EXPECT_EQ(st.cells_changed, 1u);
+  EXPECT_TRUE(s.cell(0, level).polys.empty());
+}

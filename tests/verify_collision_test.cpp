@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "app/batch.hpp"
+#include "geom/sweep.hpp"
 #include "nc/emulator.hpp"
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
@@ -66,8 +67,14 @@ TEST(IntrusionProbe, APlungeMeetsTheCylinderItWouldCut) {
   const geom::Pose from{{50, 40, 10}, {0, 0, 1}}, to{{50, 40, -5}, {0, 0, 1}};
   verify::IntrusionProbe probe;
   const verify::Intrusion in = probe.measure(solid, geom::Sweep(shape, from, to), 0.01);
-  const double expected = std::numbers::pi * 25.0 * 5.0;  // r = 5, 5 mm into the box
-  EXPECT_NEAR(in.volume_mm3, expected, 0.001 * expected);
+  // r = 5, 5 mm into the box: the tool's polygon, n vertices on r·g (Sweep::circle_grow_width),
+  // which keeps the circle's mean width, not its area (2·tol/r below it at most).
+  const int n = geom::Sweep::circle_segments(5.0, p.solid.chord_tol_mm);
+  const double rho = 5.0 * geom::Sweep::circle_grow_width(n);
+  const double expected = 0.5 * n * rho * rho * std::sin(2.0 * std::numbers::pi / n) * 5.0;
+  EXPECT_NEAR(in.volume_mm3, expected, 1e-5 * expected);
+  const double circle = std::numbers::pi * 25.0 * 5.0;
+  EXPECT_NEAR(in.volume_mm3, circle, 2.0 * p.solid.chord_tol_mm / 5.0 * circle);
   EXPECT_GT(in.deep_mm3, 0.0);
   EXPECT_NEAR(in.depth_mm, 5.0, 1e-9);
   // The probe leaves the solid as it was.

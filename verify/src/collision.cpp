@@ -135,17 +135,28 @@ int CollisionChecker::segment_findings(const geom::LbrSolid& solid, const motion
   return n;
 }
 
+namespace {
+// Material within this of a probe's boundary is not a finding: the configured tolerance
+// beyond what polygonisation alone can put there. The probe's section and the wall a
+// cut left are both polygons within ±chord tolerance of their circles, possibly on
+// different angle grids (a joined outline's, a single move's), so they may cross by up to
+// twice the chord tolerance where the exact surfaces touch (docs/verification.md).
+double probe_margin(const CheckConfig& c, const geom::LbrSolid& solid) noexcept {
+  return c.tolerance_mm + 2.0 * solid.spec().chord_tol_mm;
+}
+}  // namespace
+
 Intrusion CollisionChecker::cutting_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m) {
   if (m.ref.turning != nullptr)
-    return probe_.measure(solid, lathe_sweep(*m.ref.turning, m.ref, {0.0, 0.0}), config_.tolerance_mm, contact_only_);
-  return probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), config_.tolerance_mm, contact_only_);
+    return probe_.measure(solid, lathe_sweep(*m.ref.turning, m.ref, {0.0, 0.0}), probe_margin(config_, solid), contact_only_);
+  return probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), probe_margin(config_, solid), contact_only_);
 }
 
 int CollisionChecker::holder_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, const InsertHolder& h,
                                      Findings& out, int n) {
   const geom::LatheSweep insert = lathe_sweep(*m.ref.turning, m.ref, {0.0, 0.0});
   const Intrusion in =
-      probe_.measure(solid, lathe_sweep(h.shape, m.ref, h.offset), config_.tolerance_mm, contact_only_, &insert);
+      probe_.measure(solid, lathe_sweep(h.shape, m.ref, h.offset), probe_margin(config_, solid), contact_only_, &insert);
   if (in.deep_mm3 > 0.0) out[n++] = {EventKind::HolderInMaterial, in};
   return n;
 }
@@ -156,7 +167,7 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
     const double angle = descent_deg(m.ref.from, m.ref.to);
     if (angle > config_.max_ramp_angle_deg) {
       const Intrusion in =
-          probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to), config_.tolerance_mm, contact_only_);
+          probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to), probe_margin(config_, solid), contact_only_);
       if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
     }
   }
@@ -169,7 +180,7 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
 bool CollisionChecker::raised_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m,
                                       const geom::CutterShape& part, double from_mm, EventKind kind, Finding& out) {
   const Intrusion in =
-      probe_.measure(solid, geom::Sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm)), config_.tolerance_mm,
+      probe_.measure(solid, geom::Sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm)), probe_margin(config_, solid),
                      contact_only_);
   if (!(in.deep_mm3 > 0.0)) return false;
   out = {kind, in};
