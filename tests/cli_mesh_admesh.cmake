@@ -44,6 +44,11 @@ check_part(ball-groove 1 --program tests/data/mesh/ball-groove.ngc)
 # rounding (docs/mesh.md §6); mesh_clean_test still counts its four-use edges apart.
 check_part(helical-bore-sampled 1 --program tests/data/mesh/helical-bore.ngc --tool 3:flat:8 --sampled)
 check_part(ball-raster 1 --program tests/data/mesh/ball-raster.ngc)
+# Issue 13's helix workload in both modes: admesh-clean since cap rings start at their least
+# vertex (mesh/src/plane.cpp, canonical_order(); before: 8 facets reversed in --sampled).
+check_part(helix 1 --program bench/programs/helix.ngc)
+check_part(helix-sampled 1 --program bench/programs/helix.ngc --sampled)
+check_part(cam-pocket-blended-sampled 1 --program config/programs/cam-pocket.ngc --sampled)
 # cam-pocket's sampled stream with exact stop at every block (G61.1 after the leading %): the
 # blended stream has a fifth self-touching cap that admesh reports (docs/mesh.md §6).
 file(READ "${SRC}/config/programs/cam-pocket.ngc" pocket)

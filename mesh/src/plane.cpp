@@ -81,6 +81,7 @@ class PlaneBuilder {
   void build_caps(int dir, const EdgeSet& edges);
   void fix_ring(const Path& in, Path& out, const EdgeSet& edges);
   void emit_cap(int dir, const std::vector<Path>& rings);
+  static void canonical_order(std::vector<Path>& rings);
   MoveId cap_attr(int dir, const std::vector<Path>& rings);
   void join_narrow_steps();
   void join_border_steps();
@@ -428,8 +429,29 @@ void PlaneBuilder::build_caps(int dir, const EdgeSet& edges) {
       fix_ring(outer->Childs[h]->Contour, rings[h + 1], edges);
       for (const ClipperLib::PolyNode* isl : outer->Childs[h]->Childs) stack.push_back(isl);
     }
+    canonical_order(rings);
     emit_cap(dir, rings);
   }
+}
+
+namespace {
+bool point_less(const Point& a, const Point& b) noexcept { return a.X != b.X ? a.X < b.X : a.Y < b.Y; }
+}  // namespace
+
+// The triangulation depends only on the cap's polygon, not on where Clipper started its
+// rings: each ring starts at its least vertex (by x, then y) and the holes follow in the
+// order of theirs. Two caps of one polygon (a dent one level deep, whose up-cap below and
+// down-cap above both collapse onto the level's mid-plane when the walls join) then get the
+// same triangles, which the export drops as a fin of zero thickness (docs/mesh.md §5);
+// triangulated differently, they left the dent's chord used four times.
+void PlaneBuilder::canonical_order(std::vector<Path>& rings) {
+  for (Path& ring : rings)
+    if (!ring.empty()) std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end(), point_less), ring.end());
+  if (rings.size() > 2)
+    std::sort(rings.begin() + 1, rings.end(), [](const Path& a, const Path& b) {
+      if (a.empty() || b.empty()) return !a.empty() && b.empty();
+      return point_less(a.front(), b.front());
+    });
 }
 
 // Cap edges must be edges of the noded contours; Clipper may drop a collinear vertex, which
