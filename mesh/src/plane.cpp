@@ -82,6 +82,7 @@ class PlaneBuilder {
   void fix_ring(const Path& in, Path& out, const EdgeSet& edges);
   void emit_cap(int dir, const std::vector<Path>& rings);
   static void canonical_order(std::vector<Path>& rings);
+  bool triangulate_lobes(const std::vector<Path>& rings);
   MoveId cap_attr(int dir, const std::vector<Path>& rings);
   void join_narrow_steps();
   void join_border_steps();
@@ -454,6 +455,38 @@ void PlaneBuilder::canonical_order(std::vector<Path>& rings) {
     });
 }
 
+// Splits `ring` at the vertices it passes twice into its loops, in ring order (a loop
+// starts at the repeated vertex). False when no vertex repeats or a loop has under three.
+bool split_at_pinches(const Path& ring, std::vector<Path>& loops) {
+  Path sorted(ring);
+  std::sort(sorted.begin(), sorted.end(), point_less);
+  if (std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()) return false;
+  loops.clear();
+  Path open;
+  for (const Point& p : ring) {
+    const auto it = std::find(open.begin(), open.end(), p);
+    if (it == open.end()) {
+      open.push_back(p);
+      continue;
+    }
+    loops.emplace_back(it, open.end());
+    open.erase(it + 1, open.end());
+  }
+  loops.push_back(std::move(open));
+  return std::all_of(loops.begin(), loops.end(), [](const Path& l) { return l.size() >= 3; });
+}
+
+// The loop of `loops` that holds `hole` (a vertex strictly inside it), or loops.size().
+std::size_t loop_holding(const std::vector<Path>& loops, const Path& hole) {
+  for (const Point& v : hole)
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+      const int in = ClipperLib::PointInPolygon(v, loops[i]);
+      if (in == 1) return i;
+      if (in == -1) break;  // on this loop's boundary: try the hole's next vertex
+    }
+  return loops.size();
+}
+
 // Cap edges must be edges of the noded contours; Clipper may drop a collinear vertex, which
 // is put back here (exactly collinear plane vertices strictly inside the edge).
 void PlaneBuilder::fix_ring(const Path& in, Path& out, const EdgeSet& edges) {
@@ -492,15 +525,42 @@ void PlaneBuilder::emit_cap(int dir, const std::vector<Path>& rings) {
   const MoveId attr = cap_attr(dir, rings);
   for (const Path& ring : rings)
     for (const Point& x : ring) pd_.verts[x].attr = std::max(pd_.verts[x].attr, attr);
-  ring_ptrs_.clear();
-  for (const Path& ring : rings) ring_ptrs_.push_back(&ring);
   scratch_.tris.clear();
-  pd_.forced += triangulate(ring_ptrs_, scratch_.tris, scratch_.triangulate).forced;
+  if (!triangulate_lobes(rings)) {
+    ring_ptrs_.clear();
+    for (const Path& ring : rings) ring_ptrs_.push_back(&ring);
+    pd_.forced += triangulate(ring_ptrs_, scratch_.tris, scratch_.triangulate).forced;
+  }
   for (const Triangle2& t : scratch_.tris) {
     Tri tri{{t[0], t[1], t[2]}, {k_, k_, k_}};
     if (dir == 1) std::swap(tri.p[1], tri.p[2]);
     pd_.caps.push_back(tri);
   }
+}
+
+// An outer ring that touches itself at a vertex (Clipper joins two pieces that meet at a
+// point into one ring) is several polygons: each loop is triangulated on its own, with the
+// holes inside it. The ear clipper, given the pinched ring whole, may take a diagonal to the
+// repeated vertex and cover one loop by a fan from the other, which uses that diagonal
+// three times and leaves a four-use edge where two such caps collapse onto one mid-plane
+// (docs/mesh.md §6). Only when every loop turns the ring's way and every hole lies inside
+// one; false (nothing done) otherwise.
+bool PlaneBuilder::triangulate_lobes(const std::vector<Path>& rings) {
+  std::vector<Path>& loops = scratch_.loops;
+  if (!split_at_pinches(rings[0], loops)) return false;
+  const bool ccw = ClipperLib::Orientation(rings[0]);
+  for (const Path& l : loops)
+    if (ClipperLib::Area(l) == 0.0 || ClipperLib::Orientation(l) != ccw) return false;
+  std::vector<std::size_t> owner(rings.size(), 0);
+  for (std::size_t h = 1; h < rings.size(); ++h)
+    if ((owner[h] = loop_holding(loops, rings[h])) == loops.size()) return false;
+  for (std::size_t i = 0; i < loops.size(); ++i) {
+    ring_ptrs_.assign(1, &loops[i]);
+    for (std::size_t h = 1; h < rings.size(); ++h)
+      if (owner[h] == i) ring_ptrs_.push_back(&rings[h]);
+    pd_.forced += triangulate(ring_ptrs_, scratch_.tris, scratch_.triangulate).forced;
+  }
+  return true;
 }
 
 // Colour by time: a cap was exposed by the cuts that made its far level's contours; its

@@ -157,6 +157,7 @@ inline double plane_z(const geom::LbrSolid& s, int k) noexcept {
 struct CapScratch {
   TriangulateScratch triangulate;
   std::vector<Triangle2> tris;
+  std::vector<geom::Path> loops;  // a pinched cap ring's loops (PlaneBuilder::triangulate_lobes())
 };
 
 // Rebuilds plane k of region r (between levels k-1 and k): the two levels' contours noded
