@@ -45,7 +45,7 @@ TEST(BundledProfiles, DefaultMill3) {
   EXPECT_EQ(p.solid.level_spacing_mm, 0.1);
   EXPECT_EQ(p.solid.regions_x, 4);
   EXPECT_EQ(p.solid.regions_y, 4);
-  EXPECT_EQ(p.solid.chord_tol_mm, 0.001);
+  EXPECT_EQ(p.solid.chord_tol_mm, 0.01);
   EXPECT_FALSE(p.regions_auto);
   EXPECT_EQ(p.batch_moves, 512);                                         // app [lbr]
   EXPECT_EQ(p.threads, 0);

@@ -80,7 +80,7 @@ TEST(LiveChecks, AFastPassThroughTheStockIsARapidWithItsVolumeAndSamples) {
   rig.checks->fill_alarms(st);
   ASSERT_EQ(st.alarm_count, 1);
   EXPECT_EQ(st.alarms[0].severity, gfx::AlarmSeverity::Error);
-  EXPECT_STREQ(st.alarms[0].text.data(), "rapid-into-material T1 line 0 sample 2: 878.5 mm3 at X90.0 Y40.0 Z-1.0");
+  EXPECT_STREQ(st.alarms[0].text.data(), "rapid-into-material T1 line 0 sample 2: 878.6 mm3 at X90.0 Y40.0 Z-1.0");
 }
 
 TEST(LiveChecks, ACutAtFeedSpeedIsClean) {

@@ -22,6 +22,13 @@ using namespace lbr;
 
 namespace {
 
+// Live against batch: the stream's sweeps start and end at samples, batch's at the program's
+// corners, so their sections' polygons put their vertices elsewhere, each within ±chord
+// tolerance (0.01 mm in the built-in profile) of the exact wall. Measured at that tolerance:
+// up to 5.4e-4 of the removed volume on these small parts (2.0e-4 on the straight line);
+// 5e-4 and 2e-4 were the bounds at 1 µm.
+constexpr double kLiveVsBatch = 1e-3;
+
 std::string with_live(const std::string& extra) { return std::string(app::default_profile_text()) + "\n" + extra; }
 
 const char* kShortProgram = R"(lbr-moves 1
@@ -123,7 +130,7 @@ TEST(LiveRun, EmulatorWithToolChangesMatchesBatch) {
   EXPECT_EQ(r.samples_applied, r.samples_received);
   const nc::Emulator emu(path, app::live_emulator_limits(p));
   EXPECT_EQ(r.samples_received, emu.sample_count());
-  EXPECT_NEAR(r.removed_volume_mm3, b.removed_volume_mm3, 5e-4 * b.removed_volume_mm3);
+  EXPECT_NEAR(r.removed_volume_mm3, b.removed_volume_mm3, kLiveVsBatch * b.removed_volume_mm3);
   // With tool 1 only (live.tool, no tool numbers) the ball-nose groove would be a flat one.
   EXPECT_GT(b.removed_volume_mm3, 100.0);
 }
@@ -184,7 +191,7 @@ TEST(LiveRun, StraightRunsMergeIntoOneSweepPerBatch) {
   EXPECT_LE(r.sweeps, r.batches + 2);    // + the corner at the plunge's end, within one batch
   EXPECT_LT(r.sweeps * 20, r.samples_applied);
   const app::BatchResult b = app::run_batch(p, nc::parse_movelist(program, "line"));
-  EXPECT_NEAR(r.removed_volume_mm3, b.removed_volume_mm3, 2e-4 * b.removed_volume_mm3);
+  EXPECT_NEAR(r.removed_volume_mm3, b.removed_volume_mm3, 0.5 * kLiveVsBatch * b.removed_volume_mm3);
 }
 
 TEST(LiveRun, CandumpReplayWithFaultsMatchesBatch) {
@@ -244,7 +251,7 @@ TEST(LiveRun, CandumpReplayWithFaultsMatchesBatch) {
   EXPECT_EQ(r.ring_overruns, 0u);
   const app::BatchResult b = app::run_batch(p, path);
   EXPECT_GT(b.removed_volume_mm3, 1000.0);
-  EXPECT_NEAR(r.removed_volume_mm3, b.removed_volume_mm3, 5e-4 * b.removed_volume_mm3);
+  EXPECT_NEAR(r.removed_volume_mm3, b.removed_volume_mm3, kLiveVsBatch * b.removed_volume_mm3);
   const std::string json = app::live_metrics_json(r, p);
   for (const char* key : {"samples_received", "samples_applied", "samples_lost", "ring_overruns", "ring_high_water",
                           "decode_errors", "lag_p50_ms", "lag_p99_ms", "lag_max_ms", "removed_volume_mm3", "rt_mode"})

@@ -23,7 +23,9 @@ TEST(Tune, TimingsAreSortedAndVolumesAgree) {
   const auto t = app::tune_regions(p, tp, {{1, 1}, {4, 4}}, 1);
   ASSERT_EQ(t.size(), 2u);
   EXPECT_LE(t[0].wall_s, t[1].wall_s);
-  EXPECT_NEAR(t[0].removed_mm3, t[1].removed_mm3, 1e-3);
+  // The grids differ only by the rounding of border crossings and the slivers there: 0.011
+  // mm3 of 46 736 at the built-in 0.01 mm chord tolerance (2.3e-7).
+  EXPECT_NEAR(t[0].removed_mm3, t[1].removed_mm3, 1e-6 * t[0].removed_mm3);
   EXPECT_GT(t[0].removed_mm3, 45000.0);
 }
 

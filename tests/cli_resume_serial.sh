@@ -7,8 +7,9 @@
 # out with nobody listening: what the part lacks after a kill is only what came after the
 # snapshot, and the recording holds it. Checks: every restart catches up from the recording
 # (samples_caught_up > 0 each; the last one's in its metrics.json) and the final part is
-# the uninterrupted run's (removed volume within 0.01 %: sweeps merged differently around the
-# kills, each within [live] merge_tolerance_mm), with no sample lost on the wire.
+# the uninterrupted run's (removed volume within 0.1 %: sweeps merged differently around the
+# kills, each within [live] merge_tolerance_mm, and their polygons within the chord tolerance;
+# 0.01 % at 1 µm, up to 0.022 % measured at 0.01 mm), with no sample lost on the wire.
 # usage: cli_resume_serial.sh LBRSIM FEEDER OUT_DIR SRC_DIR [SEED]
 set -euo pipefail
 lbrsim=$1 feeder=$2 out=$3 src=$4 seed=${5:-$RANDOM}
@@ -103,5 +104,5 @@ for f in "$ref/run/metrics.json" "$m"; do
     [ "$(json "$f" $k)" = 0 ] || { echo "FAIL: $f: $k $(json "$f" $k)"; exit 1; }
   done
 done
-awk -v a="$a" -v b="$b" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a > 0 && d <= 1e-4 * a) }' ||
-  { echo "FAIL: volumes differ by more than 0.01 % ($a vs $b)"; exit 1; }
+awk -v a="$a" -v b="$b" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a > 0 && d <= 1e-3 * a) }' ||
+  { echo "FAIL: volumes differ by more than 0.1 % ($a vs $b)"; exit 1; }

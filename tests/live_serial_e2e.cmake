@@ -113,7 +113,10 @@ foreach(kind crc length garbage_bytes sequence_gap sequence_duplicate)
   endif()
 endforeach()
 json_get(vol_replay ${R} removed_volume_mm3)
-check_close(${vol_replay} ${vol_live} 0.00005 "replay vs live removed volume")
+# A replay runs as fast as it can, so its samples coalesce into other sweeps than live's: the
+# sections' vertices differ within the chord tolerance (5.3e-4 measured at 0.01 mm; 5e-5 was
+# the bound at 1 µm).
+check_close(${vol_replay} ${vol_live} 0.001 "replay vs live removed volume")
 file(SHA256 ${OUT}/replay1/levels.lbrs h1)
 file(SHA256 ${OUT}/replay2/levels.lbrs h2)
 if(NOT h1 STREQUAL h2)

@@ -19,22 +19,19 @@ namespace {
 constexpr std::size_t kTiltedGroup = 8;
 }  // namespace
 
-// Builds offset `o` of the prepared batch. Its round parts are the same n-gons as a tool's
-// disks (Sweep::circle_segments(), circle_grow_width()): vertices on radius δ = r·g with
-// n of them to a full turn (Clipper's arc tolerance δ·(1 − cos(π/n))), so the boundary stays
-// within ±tol of the exact one with no bias on the arcs; straight sides lie at δ, like a
-// stadium's sides along a grid direction.
+// Builds offset `o` of the prepared batch: the chain's path offset by exactly r, so that its
+// straight walls stand where the tool's circle puts them in every direction (a pocket's or
+// a slot's walls: no bias, where vertices on r·θ/sin θ put them up to tol/2 outside).
+// Clipper puts the round joins' and ends' vertices on r (inscribed); its arc tolerance tol/2
+// keeps them within tol/2 inside the exact arcs (docs/lbr-conventions.md, "Straight walls").
 void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
   ++stats.chain_offsets;
   const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
   SubtractShared::Offset& off = sh.offsets[o];
-  const double r = sh.offset_keys[o].r;
-  const int n = Sweep::circle_segments(r, c.shape->chord_tol_mm);
-  const double delta = r * Sweep::circle_grow_width(n) * kUnitsPerMm;
-  ClipperLib::ClipperOffset co(2.0, delta * (1.0 - std::cos(std::numbers::pi / n)));
+  ClipperLib::ClipperOffset co(2.0, 0.5 * c.shape->chord_tol_mm * kUnitsPerMm);
   co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
   off.paths.clear();
-  co.Execute(off.paths, delta);
+  co.Execute(off.paths, sh.offset_keys[o].r * kUnitsPerMm);
 }
 
 namespace {
