@@ -209,3 +209,41 @@ TEST(LbrSolid, RegressionAStripOneUnitWideIsRemovedByAPassOverIt) {
   EXPECT_EQ(st.cells_changed, 1u);
   EXPECT_TRUE(s.cell(0, level).polys.empty());
 }
+
+// A snapshot slot follows the live solid by copying only the cells that changed since its
+// last copy (LbrSolid::update_copy_of): the result equals a full copy, and a cell that did
+// not change keeps its storage.
+TEST(LbrSolid, UpdateCopyOfCopiesTheChangedCellsOnly) {
+  geom::SolidSpec spec;
+  spec.box = {{0, 0, -10}, {40, 30, 0}};
+  spec.level_spacing_mm = 0.5;
+  spec.regions_x = 4;
+  spec.regions_y = 3;
+  geom::LbrSolid live(spec);
+  geom::Tool t;
+  t.diameter_mm = 6.0;
+  const geom::CutterShape flat = geom::CutterShape::build(t, 0.01);
+  const geom::SweepRef first{&flat, geom::Pose{{-5, 5, -3}}, geom::Pose{{45, 5, -3}}, 1};
+  live.subtract(std::span<const geom::SweepRef>(&first, 1));
+  geom::SolidSpec other = spec;  // another grid: the first update is a full copy
+  other.regions_x = 1;
+  geom::LbrSolid slot(other);
+  slot.update_copy_of(live);
+  EXPECT_DOUBLE_EQ(slot.volume_mm3(), live.volume_mm3());
+  const int far_region = 11, level = 15;  // x 30..40, y 20..30: the second cut misses it
+  const auto* kept = slot.cell(far_region, level).polys.data();
+  const geom::SweepRef second{&flat, geom::Pose{{5, -5, -6}}, geom::Pose{{5, 25, -6}}, 2};
+  live.subtract(std::span<const geom::SweepRef>(&second, 1));
+  ASSERT_NE(slot.volume_mm3(), live.volume_mm3());
+  slot.update_copy_of(live);
+  EXPECT_DOUBLE_EQ(slot.volume_mm3(), live.volume_mm3());
+  EXPECT_EQ(slot.cell(far_region, level).polys.data(), kept);
+  for (int r = 0; r < live.regions(); ++r)
+    for (int l = 0; l < live.levels(); ++l) {
+      const geom::Cell& a = slot.cell(r, l);
+      const geom::Cell& b = live.cell(r, l);
+      ASSERT_EQ(a.version, b.version);
+      ASSERT_EQ(a.polys.size(), b.polys.size());
+      for (std::size_t p = 0; p < a.polys.size(); ++p) ASSERT_EQ(a.polys[p].outer.pts, b.polys[p].outer.pts);
+    }
+}

@@ -93,6 +93,22 @@ LbrSolid& LbrSolid::operator=(const LbrSolid& o) {
   return *this;
 }
 
+void LbrSolid::update_copy_of(const LbrSolid& o) {
+  if (this == &o) return;
+  if (levels_ != o.levels_ || xs_ != o.xs_ || ys_ != o.ys_ || cells_.size() != o.cells_.size()) {
+    *this = o;
+    return;
+  }
+  spec_ = o.spec_;
+  z0_ = o.z0_;
+  z1_ = o.z1_;
+  xy_ = o.xy_;
+  initial_volume_mm3_ = o.initial_volume_mm3_;
+  dirty_flag_ = o.dirty_flag_;
+  for (std::size_t i = 0; i < cells_.size(); ++i)
+    if (cells_[i].version != o.cells_[i].version) cells_[i] = o.cells_[i];
+}
+
 void LbrSolid::init_cells(bool fill) {
   const int nx = spec_.regions_x, ny = spec_.regions_y;
   xs_.resize(nx + 1);

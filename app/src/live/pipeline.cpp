@@ -246,7 +246,7 @@ void offer_snapshot(LivePipeline::Impl& p, std::int64_t& due_ns) {
   SnapshotState* s = p.snap->slot();
   if (s == nullptr) return;
   const std::int64_t t0 = sched::now_ns();
-  s->solid = p.r->solid;
+  s->solid.update_copy_of(p.r->solid);
   fill_snapshot(p, *s);
   p.snap->commit();
   const std::int64_t took = sched::now_ns() - t0;

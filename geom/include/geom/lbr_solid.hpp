@@ -153,6 +153,12 @@ class LbrSolid {
   LbrSolid& operator=(LbrSolid&&) noexcept;
   LbrSolid(const LbrSolid&);
   LbrSolid& operator=(const LbrSolid&);
+  // Makes this solid equal to `o`, copying only the cells whose version differs from this
+  // one's, into the storage this one has (a live snapshot's slot: the cells the run changed
+  // since the slot's last copy, no allocation once the slot has grown). For a solid last
+  // made equal to `o` by this or a copy and not changed since; where the grids differ, a
+  // full copy.
+  void update_copy_of(const LbrSolid& o);
 
   // Removes the union of the sweeps from the stock: per (region, level) touched, one
   // polygon difference. Cells are skipped by bounding boxes first. Changed cells are marked
