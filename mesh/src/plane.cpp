@@ -437,23 +437,6 @@ void PlaneBuilder::build_caps(int dir, const EdgeSet& edges) {
 
 namespace {
 bool point_less(const Point& a, const Point& b) noexcept { return a.X != b.X ? a.X < b.X : a.Y < b.Y; }
-}  // namespace
-
-// The triangulation depends only on the cap's polygon, not on where Clipper started its
-// rings: each ring starts at its least vertex (by x, then y) and the holes follow in the
-// order of theirs. Two caps of one polygon (a dent one level deep, whose up-cap below and
-// down-cap above both collapse onto the level's mid-plane when the walls join) then get the
-// same triangles, which the export drops as a fin of zero thickness (docs/mesh.md §5);
-// triangulated differently, they left the dent's chord used four times.
-void PlaneBuilder::canonical_order(std::vector<Path>& rings) {
-  for (Path& ring : rings)
-    if (!ring.empty()) std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end(), point_less), ring.end());
-  if (rings.size() > 2)
-    std::sort(rings.begin() + 1, rings.end(), [](const Path& a, const Path& b) {
-      if (a.empty() || b.empty()) return !a.empty() && b.empty();
-      return point_less(a.front(), b.front());
-    });
-}
 
 // Splits `ring` at the vertices it passes twice into its loops, in ring order (a loop
 // starts at the repeated vertex). False when no vertex repeats or a loop has under three.
@@ -485,6 +468,24 @@ std::size_t loop_holding(const std::vector<Path>& loops, const Path& hole) {
       if (in == -1) break;  // on this loop's boundary: try the hole's next vertex
     }
   return loops.size();
+}
+
+}  // namespace
+
+// The triangulation depends only on the cap's polygon, not on where Clipper started its
+// rings: each ring starts at its least vertex (by x, then y) and the holes follow in the
+// order of theirs. Two caps of one polygon (a dent one level deep, whose up-cap below and
+// down-cap above both collapse onto the level's mid-plane when the walls join) then get the
+// same triangles, which the export drops as a fin of zero thickness (docs/mesh.md §5);
+// triangulated differently, they left the dent's chord used four times.
+void PlaneBuilder::canonical_order(std::vector<Path>& rings) {
+  for (Path& ring : rings)
+    if (!ring.empty()) std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end(), point_less), ring.end());
+  if (rings.size() > 2)
+    std::sort(rings.begin() + 1, rings.end(), [](const Path& a, const Path& b) {
+      if (a.empty() || b.empty()) return !a.empty() && b.empty();
+      return point_less(a.front(), b.front());
+    });
 }
 
 // Cap edges must be edges of the noded contours; Clipper may drop a collinear vertex, which
