@@ -199,12 +199,14 @@ TEST(LbrSolid, RegressionAStripOneUnitWideIsRemovedByAPassOverIt) {
   strip.outer.pts = {{geom::to_units(20.0), geom::to_units(16.0)}, {0, geom::to_units(16.0)},
                      {0, geom::to_units(16.0) - 1}, {geom::to_units(20.0), geom::to_units(16.0) - 1}};
   strip.bbox = geom::bounds_of(strip.outer.pts);
-  for (int l = 0; l < s.levels(); ++l) s.set_cell(0, l, l == level ? std::vector<geom::Polygon>{strip} : std::vector<geom::Polygon>{});
+  for (int l = 0; l < s.levels(); ++l)
+    s.set_cell(0, l, l == level ? std::vector<geom::Polygon>{strip} : std::vector<geom::Polygon>{});
   ASSERT_FALSE(s.cell(0, level).bbox.empty());
   geom::Tool t;
   t.diameter_mm = 6.0;
   const geom::CutterShape flat = geom::CutterShape::build(t, 0.001);
-  const geom::SweepRef ref{&flat, geom::Pose{{-4, 14, 2}}, geom::Pose{{24, 14, 2}}, 1};  // covers y 11..17 on every level above z 2
+  // Covers y 11..17 on every level above z 2.
+  const geom::SweepRef ref{&flat, geom::Pose{{-4, 14, 2}}, geom::Pose{{24, 14, 2}}, 1};
   const geom::SubtractStats st = s.subtract(std::span<const geom::SweepRef>(&ref, 1));
   EXPECT_EQ(st.cells_changed, 1u);
   EXPECT_TRUE(s.cell(0, level).polys.empty());

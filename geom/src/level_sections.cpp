@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <numbers>
 
 #include "chain_outline.hpp"
 #include "polygon_ops.hpp"

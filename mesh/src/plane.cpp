@@ -440,14 +440,23 @@ bool point_less(const Point& a, const Point& b) noexcept { return a.X != b.X ? a
 
 // Splits `ring` at the vertices it passes twice into its loops, in ring order (a loop
 // starts at the repeated vertex). False when no vertex repeats or a loop has under three.
-bool split_at_pinches(const Path& ring, std::vector<Path>& loops) {
-  Path sorted(ring);
-  std::sort(sorted.begin(), sorted.end(), point_less);
-  if (std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()) return false;
+// `repeated` is scratch: the ring's repeated vertices, sorted, once each.
+bool split_at_pinches(const Path& ring, Path& repeated, std::vector<Path>& loops) {
+  repeated.assign(ring.begin(), ring.end());
+  std::sort(repeated.begin(), repeated.end(), point_less);
+  auto kept = repeated.begin();
+  for (auto i = repeated.begin(); i != repeated.end();) {
+    const auto j = std::find_if(i, repeated.end(), [&](const Point& q) { return !(q == *i); });
+    if (j - i > 1) *kept++ = *i;
+    i = j;
+  }
+  repeated.erase(kept, repeated.end());
+  if (repeated.empty()) return false;
   loops.clear();
   Path open;
   for (const Point& p : ring) {
-    const auto it = std::find(open.begin(), open.end(), p);
+    const bool pinch = std::binary_search(repeated.begin(), repeated.end(), p, point_less);
+    const auto it = pinch ? std::find(open.begin(), open.end(), p) : open.end();
     if (it == open.end()) {
       open.push_back(p);
       continue;
@@ -548,7 +557,7 @@ void PlaneBuilder::emit_cap(int dir, const std::vector<Path>& rings) {
 // one; false (nothing done) otherwise.
 bool PlaneBuilder::triangulate_lobes(const std::vector<Path>& rings) {
   std::vector<Path>& loops = scratch_.loops;
-  if (!split_at_pinches(rings[0], loops)) return false;
+  if (!split_at_pinches(rings[0], scratch_.repeated, loops)) return false;
   const bool ccw = ClipperLib::Orientation(rings[0]);
   for (const Path& l : loops)
     if (ClipperLib::Area(l) == 0.0 || ClipperLib::Orientation(l) != ccw) return false;

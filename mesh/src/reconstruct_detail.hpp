@@ -158,6 +158,7 @@ struct CapScratch {
   TriangulateScratch triangulate;
   std::vector<Triangle2> tris;
   std::vector<geom::Path> loops;  // a pinched cap ring's loops (PlaneBuilder::triangulate_lobes())
+  geom::Path repeated;            // the vertices a cap ring passes twice
 };
 
 // Rebuilds plane k of region r (between levels k-1 and k): the two levels' contours noded

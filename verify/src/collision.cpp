@@ -147,9 +147,10 @@ double probe_margin(const CheckConfig& c, const geom::LbrSolid& solid) noexcept 
 }  // namespace
 
 Intrusion CollisionChecker::cutting_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m) {
+  const double margin = probe_margin(config_, solid);
   if (m.ref.turning != nullptr)
-    return probe_.measure(solid, lathe_sweep(*m.ref.turning, m.ref, {0.0, 0.0}), probe_margin(config_, solid), contact_only_);
-  return probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), probe_margin(config_, solid), contact_only_);
+    return probe_.measure(solid, lathe_sweep(*m.ref.turning, m.ref, {0.0, 0.0}), margin, contact_only_);
+  return probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), margin, contact_only_);
 }
 
 int CollisionChecker::holder_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, const InsertHolder& h,
@@ -179,9 +180,8 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
 
 bool CollisionChecker::raised_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m,
                                       const geom::CutterShape& part, double from_mm, EventKind kind, Finding& out) {
-  const Intrusion in =
-      probe_.measure(solid, geom::Sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm)), probe_margin(config_, solid),
-                     contact_only_);
+  const geom::Sweep sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm));
+  const Intrusion in = probe_.measure(solid, sweep, probe_margin(config_, solid), contact_only_);
   if (!(in.deep_mm3 > 0.0)) return false;
   out = {kind, in};
   return true;
