@@ -112,7 +112,9 @@ void expect_path(const std::string& program, const std::vector<std::array<double
     EXPECT_NEAR(feeds[i][1], want_feeds[i][1], 1e-9) << i;
   }
   if (nc::find_rs274().empty()) return;
-  const std::string path = ::testing::TempDir() + "g7x_path.ngc";
+  // One file per test: ctest runs the cases as parallel processes (a shared name raced).
+  const std::string path =
+      ::testing::TempDir() + "g7x_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".ngc";
   std::ofstream(path) << program;
   const std::vector<std::array<double, 3>> theirs = path_of(nc::run_rs274(path, o));
   ASSERT_EQ(ours.size(), theirs.size());
