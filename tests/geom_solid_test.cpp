@@ -212,15 +212,21 @@ TEST(LbrSolid, RegressionAStripOneUnitWideIsRemovedByAPassOverIt) {
   EXPECT_TRUE(s.cell(0, level).polys.empty());
 }
 
-// A snapshot slot follows the live solid by copying only the cells that changed since its
-// last copy (LbrSolid::update_copy_of): the result equals a full copy, and a cell that did
-// not change keeps its storage.
-TEST(LbrSolid, UpdateCopyOfCopiesTheChangedCellsOnly) {
+// The snapshot slot tests' stock: 40 x 30 x 10 mm in 4 x 3 regions, levels 0.5 mm apart.
+geom::SolidSpec snapshot_test_spec() {
   geom::SolidSpec spec;
   spec.box = {{0, 0, -10}, {40, 30, 0}};
   spec.level_spacing_mm = 0.5;
   spec.regions_x = 4;
   spec.regions_y = 3;
+  return spec;
+}
+
+// A snapshot slot follows the live solid by copying only the cells that changed since its
+// last copy (LbrSolid::update_copy_of): the result equals a full copy, and a cell that did
+// not change keeps its storage.
+TEST(LbrSolid, UpdateCopyOfCopiesTheChangedCellsOnly) {
+  const geom::SolidSpec spec = snapshot_test_spec();
   geom::LbrSolid live(spec);
   geom::Tool t;
   t.diameter_mm = 6.0;
@@ -248,4 +254,53 @@ TEST(LbrSolid, UpdateCopyOfCopiesTheChangedCellsOnly) {
       ASSERT_EQ(a.polys.size(), b.polys.size());
       for (std::size_t p = 0; p < a.polys.size(); ++p) ASSERT_EQ(a.polys[p].outer.pts, b.polys[p].outer.pts);
     }
+}
+
+// The live snapshot's copy a slice at a time (LbrSolid::update_copy_slice): each slice
+// copies at most its budget of changed cells and says where it stopped; the passes over
+// the cells end equal to the live solid, and a pass that the solid changes in the middle of
+// leaves the cells it had passed behind, which the next pass catches up.
+TEST(LbrSolid, UpdateCopySliceCopiesAtMostItsBudgetAndCatchesUp) {
+  const geom::SolidSpec spec = snapshot_test_spec();
+  geom::LbrSolid live(spec);
+  geom::LbrSolid slot(spec);
+  ASSERT_TRUE(slot.same_grid(live));
+  EXPECT_EQ(slot.cell_count(), static_cast<std::size_t>(live.regions() * live.levels()));
+  geom::Tool t;
+  t.diameter_mm = 6.0;
+  const geom::CutterShape flat = geom::CutterShape::build(t, 0.01);
+  const geom::SweepRef first{&flat, geom::Pose{{-5, 5, -3}}, geom::Pose{{45, 5, -3}}, 1};
+  live.subtract(std::span<const geom::SweepRef>(&first, 1));
+  auto changed = [&] {
+    std::size_t n = 0;
+    for (int r = 0; r < live.regions(); ++r)
+      for (int l = 0; l < live.levels(); ++l) n += slot.cell(r, l).version != live.cell(r, l).version ? 1 : 0;
+    return n;
+  };
+  const std::size_t to_copy = changed();
+  ASSERT_GT(to_copy, 4u);
+  // Slices of 3 cells: each stops right after its third copy (or at the end).
+  std::size_t at = 0, slices = 0;
+  while (at < slot.cell_count()) {
+    const std::size_t before = changed();
+    at = slot.update_copy_slice(live, at, 3);
+    ++slices;
+    EXPECT_EQ(before - changed(), std::min<std::size_t>(3, before)) << "slice " << slices;
+  }
+  EXPECT_EQ(slices, (to_copy + 2) / 3 + (to_copy % 3 == 0 ? 1 : 0));
+  EXPECT_EQ(changed(), 0u);
+  EXPECT_DOUBLE_EQ(slot.volume_mm3(), live.volume_mm3());
+  // The live solid changes in the middle of a pass: cells before the cursor stay behind.
+  const geom::SweepRef second{&flat, geom::Pose{{5, -5, -6}}, geom::Pose{{5, 25, -6}}, 2};
+  const geom::SweepRef third{&flat, geom::Pose{{5, -5, -8}}, geom::Pose{{5, 25, -8}}, 3};
+  live.subtract(std::span<const geom::SweepRef>(&second, 1));
+  at = 0;
+  while (at < static_cast<std::size_t>(live.levels())) at = slot.update_copy_slice(live, at, 1);  // region 0 passed
+  live.subtract(std::span<const geom::SweepRef>(&third, 1));  // deeper in region 0 (and 4, 8)
+  while (at < slot.cell_count()) at = slot.update_copy_slice(live, at, 1000);
+  EXPECT_GT(changed(), 0u);  // region 0's cells missed the third cut
+  EXPECT_NE(slot.volume_mm3(), live.volume_mm3());
+  EXPECT_EQ(slot.update_copy_slice(live, 0, slot.cell_count()), slot.cell_count());
+  EXPECT_EQ(changed(), 0u);
+  EXPECT_DOUBLE_EQ(slot.volume_mm3(), live.volume_mm3());
 }

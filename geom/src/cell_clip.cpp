@@ -242,8 +242,7 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
   refresh_cell(cell);
   cell.last_cut = 0;
   for (std::uint32_t k : ws.selected) cell.last_cut = std::max(cell.last_cut, ls.id[k]);
-  ++cell.version;
-  s_.dirty_flag_[ci] = 1;
+  s_.changed(ci);
   ++stats.cells_changed;
   return true;
 }

@@ -86,7 +86,7 @@ LbrSolid::LbrSolid(LbrSolid&&) noexcept = default;
 LbrSolid& LbrSolid::operator=(LbrSolid&&) noexcept = default;
 LbrSolid::LbrSolid(const LbrSolid& o)
     : spec_(o.spec_), levels_(o.levels_), z0_(o.z0_), z1_(o.z1_), xy_(o.xy_), xs_(o.xs_), ys_(o.ys_),
-      cells_(o.cells_), dirty_flag_(o.dirty_flag_), initial_volume_mm3_(o.initial_volume_mm3_),
+      cells_(o.cells_), dirty_flag_(o.dirty_flag_), versions_(o.versions_), initial_volume_mm3_(o.initial_volume_mm3_),
       ws_(std::make_unique<detail::SubtractWorkspace>()) {}
 LbrSolid& LbrSolid::operator=(const LbrSolid& o) {
   if (this != &o) *this = LbrSolid(o);
@@ -95,18 +95,33 @@ LbrSolid& LbrSolid::operator=(const LbrSolid& o) {
 
 void LbrSolid::update_copy_of(const LbrSolid& o) {
   if (this == &o) return;
-  if (levels_ != o.levels_ || xs_ != o.xs_ || ys_ != o.ys_ || cells_.size() != o.cells_.size()) {
+  if (!same_grid(o)) {
     *this = o;
     return;
   }
+  (void)update_copy_slice(o, 0, cells_.size());
+}
+
+bool LbrSolid::same_grid(const LbrSolid& o) const noexcept {
+  return levels_ == o.levels_ && xs_ == o.xs_ && ys_ == o.ys_ && cells_.size() == o.cells_.size();
+}
+
+std::size_t LbrSolid::update_copy_slice(const LbrSolid& o, std::size_t from, std::size_t max_cells) {
+  std::size_t i = from, copied = 0;
+  for (; i < cells_.size() && copied < max_cells; ++i) {
+    if (versions_[i] == o.versions_[i]) continue;
+    cells_[i] = o.cells_[i];
+    versions_[i] = o.versions_[i];
+    ++copied;
+  }
+  if (i < cells_.size()) return i;
   spec_ = o.spec_;
   z0_ = o.z0_;
   z1_ = o.z1_;
   xy_ = o.xy_;
   initial_volume_mm3_ = o.initial_volume_mm3_;
   dirty_flag_ = o.dirty_flag_;
-  for (std::size_t i = 0; i < cells_.size(); ++i)
-    if (cells_[i].version != o.cells_[i].version) cells_[i] = o.cells_[i];
+  return i;
 }
 
 void LbrSolid::init_cells(bool fill) {
@@ -117,6 +132,7 @@ void LbrSolid::init_cells(bool fill) {
   for (int j = 0; j <= ny; ++j) ys_[j] = xy_.y0 + (xy_.y1 - xy_.y0) * j / ny;
   cells_.assign(static_cast<std::size_t>(regions()) * levels_, Cell{});
   dirty_flag_.assign(cells_.size(), 0);
+  versions_.assign(cells_.size(), 0);
   std::vector<double> region_area(static_cast<std::size_t>(regions()));
   const Path circle = stock_circle();
   Path cut, tmp, wedge;  // stock_polygons' scratch, reused over the regions
@@ -330,8 +346,7 @@ void LbrSolid::set_cell(int region, int level, std::vector<Polygon> polys, MoveI
   c.last_cut = last_cut;
   for (Polygon& p : c.polys) p.bbox = bounds_of(p.outer.pts);
   detail::refresh_cell(c);
-  ++c.version;
-  dirty_flag_[i] = 1;
+  changed(i);
 }
 
 SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch) { return detail::SubtractEngine(*this).subtract(batch, *ws_); }
@@ -377,8 +392,7 @@ SubtractStats LbrSolid::subtract_solid(const LbrSolid& other, MoveId id) {
       cell.polys.swap(ws.fresh);
       detail::refresh_cell(cell);
       cell.last_cut = id;
-      ++cell.version;
-      dirty_flag_[ci] = 1;
+      changed(ci);
       ++stats.cells_changed;
     }
   }

@@ -206,8 +206,7 @@ void SubtractEngine::copy_runs(const SubtractShared& sh, const SubtractWorkspace
         to.bbox = from.bbox;
         to.area_units2 = from.area_units2;
         to.last_cut = from.last_cut;
-        ++to.version;
-        s_.dirty_flag_[ci] = 1;
+        s_.changed(ci);
         ++stats.cells_changed;
       }
   }

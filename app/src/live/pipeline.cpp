@@ -76,7 +76,15 @@ struct LivePipeline::Impl {
   RecMark rec_start;
   std::int64_t next_mark_ns = 0;
   std::string rec_path;
-  std::atomic<std::int64_t> snapshot_copy_max_ns{0};  // longest copy of the solid on the geometry thread
+  std::atomic<std::int64_t> snapshot_copy_max_ns{0};  // longest copy step on the geometry thread
+  // A periodic snapshot's copy in progress (offer_snapshot()): the next cell to compare and
+  // the passes so far that spanned batches.
+  struct SnapshotCopy {
+    bool active = false;
+    std::size_t cursor = 0;
+    int passes = 0;
+  };
+  SnapshotCopy snap_copy;
 
   // start() .. stop()
   std::atomic<bool> stop_requested{false};
@@ -239,18 +247,49 @@ void fill_snapshot(const LivePipeline::Impl& p, SnapshotState& s) {
   s.wall_time_s = p.wall_base_s + static_cast<double>(sched::now_ns() - p.t0) * 1e-9;
 }
 
-// Periodic snapshot at a batch boundary: the solid is copied into the writer's free slot
-// (no I/O, no waiting; a busy writer means trying again after the next batch).
+// A periodic snapshot's copy at one batch boundary lasts at most this long...
+constexpr std::int64_t kSnapshotSliceNs = 1'000'000;
+// ...checked after this many copied cells.
+constexpr std::size_t kSnapshotSliceCells = 64;
+// After this many passes that spanned batches, the next pass runs to its end in one step:
+// the snapshots go on, with one longer step, where a pass never fits in one slice.
+constexpr int kSnapshotSlicedPasses = 6;
+
+// Periodic snapshot (docs/snapshot.md, "Threads and cost"): once due, the cells changed
+// since the writer's slot last held the solid are copied into it, a slice of at most
+// kSnapshotSliceNs per batch boundary (no waiting, no I/O, no stall of a whole copy). A
+// pass over the cells that spans several batches is no single state of the solid, so the
+// passes repeat (each copies only what changed since the last) until one starts and ends at
+// the same boundary; that boundary is the snapshot's moment. A busy writer means trying
+// again after the next batch.
 void offer_snapshot(LivePipeline::Impl& p, std::int64_t& due_ns) {
-  if (!p.snap || sched::now_ns() < due_ns) return;
-  SnapshotState* s = p.snap->slot();
-  if (s == nullptr) return;
+  if (!p.snap) return;
+  LivePipeline::Impl::SnapshotCopy& c = p.snap_copy;
+  if (!c.active) {
+    if (sched::now_ns() < due_ns || p.snap->slot() == nullptr) return;
+    c = {true, 0, 0};
+  }
+  SnapshotState* s = p.snap->slot();  // still free: only this thread commits it
+  const geom::LbrSolid& solid = p.r->solid;
   const std::int64_t t0 = sched::now_ns();
-  s->solid.update_copy_of(p.r->solid);
-  fill_snapshot(p, *s);
-  p.snap->commit();
+  const bool whole = c.cursor == 0;  // the pass starts at this boundary
+  const bool forced = whole && c.passes >= kSnapshotSlicedPasses;
+  if (whole && !s->solid.same_grid(solid)) s->solid = solid;  // (start_snapshots() gave it the grid)
+  while (c.cursor < solid.cell_count()) {
+    c.cursor = s->solid.update_copy_slice(solid, c.cursor, kSnapshotSliceCells);
+    if (!forced && sched::now_ns() - t0 > kSnapshotSliceNs) break;
+  }
   const std::int64_t took = sched::now_ns() - t0;
   if (took > p.snapshot_copy_max_ns.load(std::memory_order_relaxed)) p.snapshot_copy_max_ns.store(took, std::memory_order_relaxed);
+  if (c.cursor < solid.cell_count()) return;  // on at the next boundary
+  if (!whole) {  // the solid changed during the pass: another one
+    c.cursor = 0;
+    ++c.passes;
+    return;
+  }
+  fill_snapshot(p, *s);
+  p.snap->commit();
+  c.active = false;
   due_ns = sched::now_ns() + p.snapshot_period_ns;
 }
 

@@ -159,6 +159,16 @@ class LbrSolid {
   // made equal to `o` by this or a copy and not changed since; where the grids differ, a
   // full copy.
   void update_copy_of(const LbrSolid& o);
+  // update_copy_of() a slice at a time, for a caller that must not stall for the whole
+  // copy (the live geometry thread): compares the cells from `from` on (in storage order)
+  // and copies those whose version differs, until it has copied `max_cells` of them or
+  // compared all; returns the first cell it did not compare, cell_count() once done (and
+  // then the solid-wide state is copied too). Requires same_grid(o). The slices of one pass
+  // make this solid equal to `o` only when `o` did not change between them.
+  [[nodiscard]] std::size_t update_copy_slice(const LbrSolid& o, std::size_t from, std::size_t max_cells);
+  // The same levels and region borders: update_copy_slice() may be used.
+  [[nodiscard]] bool same_grid(const LbrSolid& o) const noexcept;
+  [[nodiscard]] std::size_t cell_count() const noexcept { return cells_.size(); }
 
   // Removes the union of the sweeps from the stock: per (region, level) touched, one
   // polygon difference. Cells are skipped by bounding boxes first. Changed cells are marked
@@ -221,8 +231,13 @@ class LbrSolid {
   void set_cell(int region, int level, std::vector<Polygon> polys, MoveId last_cut = 0);
 
  private:
-  friend class detail::SubtractEngine;  // reads the grid, writes cells and dirty flags
+  friend class detail::SubtractEngine;  // reads the grid, writes cells (and marks them changed())
   LbrSolid(const SolidSpec& spec, bool fill);
+  // After a change of cell `i`: its version goes up (in the cell and in versions_) and it is dirty.
+  void changed(std::size_t i) noexcept {
+    versions_[i] = ++cells_[i].version;
+    dirty_flag_[i] = 1;
+  }
   void init_cells(bool fill);  // grid, initial volume; fill: every cell holds the stock
   [[nodiscard]] Path stock_circle() const;  // the cylinder polygonised (empty for a box)
   [[nodiscard]] std::vector<Polygon> stock_polygons(int region, const Path& circle, Path& cut, Path& tmp,
@@ -238,6 +253,9 @@ class LbrSolid {
   std::vector<Coord> xs_, ys_;  // region boundaries, nx+1 and ny+1 values
   std::vector<Cell> cells_;
   std::vector<std::uint8_t> dirty_flag_;
+  // Each cell's version, side by side: update_copy_slice() finds the changed cells by
+  // reading 4 bytes per cell, not a cache line of each Cell.
+  std::vector<std::uint32_t> versions_;
   double initial_volume_mm3_ = 0;
   std::unique_ptr<detail::SubtractWorkspace> ws_;  // for subtract() and subtract_solid()
 };
