@@ -9,6 +9,7 @@
 #include "app/outputs.hpp"
 #include "app/profile.hpp"
 #include "kin/kinematics.hpp"
+#include "nc/emulator.hpp"
 #include "nc/gcode.hpp"
 #include "test_util.hpp"
 
@@ -297,6 +298,29 @@ TEST(Mill5, ZeroTiltGivesTheSameResultAsMill3) {
       ASSERT_EQ(a.size(), b.size());
       for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i].outer.pts, b[i].outer.pts);
     }
+  }
+}
+
+// A tool change keeps the gauge line where it is, so a longer tool's tip comes down by the
+// difference of the lengths (docs/nc-frontend.md): the next move starts from that tip, on
+// G-code segments as on the machine's sampled stream. Default profile: T2 (ball, 50 mm) at
+// Z2, then T1 (flat Ø10, 60 mm) without a new G43 stands 8 mm deep; G1 X40 cuts a slot from
+// there, an exact prism of a stadium (20 x 10 mm plus the two half disks) 8 mm deep. Before
+// the fix the segments ran the slot from the old tip, a ramp down from Z2 (1 267 mm³).
+TEST(ToolChange, TheNextMoveStartsFromTheNewToolsTip) {
+  const std::string prog = "G21 G90 G17\nT2 M6\nG43 H2\nS8000 M3\nG0 X20 Y20 Z2\nT1 M6\nG1 X40 F500\nG0 Z60\n";
+  for (const bool mill5 : {false, true}) {
+    app::Profile p = app::default_profile();
+    if (mill5) {  // the axes through the kinematics (SweepMapper), not the direct path
+      p.kin.kind = nc::MachineKind::Mill5;
+      p.kin.rotary = kin::Rotary::TableAC;
+    }
+    const nc::Toolpath path = nc::interpret_gcode(prog, "p.ngc", app::gcode_options(p));
+    const double expect = (20.0 * 10.0 + test::kPi * 25.0) * 8.0;
+    const double segments = app::run_batch(p, path).removed_volume_mm3;
+    const double sampled = app::run_batch(p, nc::sampled_toolpath(path, app::emulator_limits(p))).removed_volume_mm3;
+    EXPECT_NEAR(segments, expect, 1e-3 * expect) << (mill5 ? "mill5" : "mill3");
+    EXPECT_NEAR(sampled, expect, 1e-3 * expect) << (mill5 ? "mill5" : "mill3");
   }
 }
 

@@ -73,6 +73,12 @@ void path_sweeps(const ToolTable& tools, const kin::Kinematics& k, const nc::Too
     const nc::Segment& s = path.segments[i];
     const double t_end = end_time != nullptr ? (*end_time)[i] : t;
     if (!is_motion(s)) {
+      // A tool change moves the tip without a motion (the gauge line stays where it is, the
+      // new tool's length differs: docs/nc-frontend.md): the next motion starts from the new
+      // tip, as the machine's (and the sampled stream's) does.
+      if (direct || s.has_tool_axis) pose.tip = pose_of(s.end, s.tool_axis).tip;
+      else pose = kin::tool_pose(k, s.end, tools.mount_of(s.tool));
+      q = s.end;
       t = t_end;
       continue;
     }
