@@ -12,6 +12,8 @@ PACKAGES=(
   # libraries (found by CMake find_package / pkg-config)
   libpolyclipping-dev libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
   libglfw3-dev libx11-dev libglm-dev libepoxy-dev libstb-dev libserial-dev linux-libc-dev libsystemd-dev
+  # the executables' heap allocator (tcmalloc, CMakeLists.txt LBR_MALLOC)
+  libgoogle-perftools-dev
   # Debian package (cmake --build build --target package) and its checks (ctest -L package)
   lintian debootstrap
   # operator UI (Dear ImGui with its OpenGL 3 backend, docs/ui.md)
