@@ -82,6 +82,8 @@ with open(program) as f:
             ops.append(("tool", tool))
         if not any(a in w for a in "XYZ") or motion is None:
             continue
+        if "53" in gs:  # G53: machine coordinates (the retract before a tool change), not the part's
+            continue
         nxt = [w.get("X", pos[0]), w.get("Y", pos[1]), w.get("Z", pos[2])]
         if motion in ("G2", "G3"):
             cx, cy = pos[0] + w.get("I", 0.0), pos[1] + w.get("J", 0.0)
