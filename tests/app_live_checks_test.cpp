@@ -169,3 +169,23 @@ TEST(LiveChecks, AGrooveDeeperThanTheBladeDrivesTheHolderIn) {
 }
 
 }  // namespace
+
+// A tool change in the stream: the new tool starts where its first sample puts it (no sweep
+// from the old tool's last position), and standing in the stock there raises
+// tool-change-in-material with the material its body holds: T1 (flat Ø10) 8 mm deep,
+// π·25·8 mm³ less the two-sided polygon's share.
+TEST(LiveChecks, AToolLoadedIntoTheStockIsReportedWhereItStands) {
+  Rig rig;
+  for (int i = 0; i < 5; ++i) (void)rig.ring.try_push(sample(rig.seq++, 20.0, 20.0, 2.0 + 0.01 * i, 2));
+  for (int i = 0; i <= 180; ++i) (void)rig.ring.try_push(sample(rig.seq++, 20.0, 20.0, -8.0 + 0.1 * i, 1));  // 6 m/min up
+  (void)rig.geo->tick(4096);
+  const std::vector<verify::Event> ev = rig.checks->events();
+  ASSERT_EQ(ev.size(), 1u);
+  const verify::Event& e = ev[0];
+  EXPECT_EQ(e.kind, verify::EventKind::ToolChangeInMaterial);
+  EXPECT_EQ(e.tool, 1);
+  EXPECT_NEAR(e.position.z, -8.0, 1e-9);
+  const double cylinder = std::numbers::pi * 25.0 * 8.0;
+  EXPECT_NEAR(e.volume_mm3, cylinder, 0.005 * cylinder);
+  EXPECT_NEAR(rig.solid.initial_volume_mm3() - rig.solid.volume_mm3(), e.volume_mm3, 0.005 * cylinder);
+}

@@ -522,3 +522,30 @@ TEST(CollisionChecks, TheSpindleNoseBesideTheStockIsReportedAtItsLine) {
   const app::BatchResult off = run(program("-35"));
   EXPECT_EQ(count_kind(off.events, verify::EventKind::SpindleNoseInMaterial), 0u);
 }
+
+// tool-change-in-material: M6 keeps the gauge line where it is, so T1 (60 mm) loaded after
+// T2 (50 mm) at Z2 stands 8 mm deep in the stock top (docs/nc-frontend.md). Its first move
+// raises the event where the tool stood, with the material its body held there: the flat
+// Ø10 cylinder, 8 mm of it below the top (π·25·8 = 628.3 mm³; the tool's polygon is a
+// two-sided 10 µm n-gon, a little less). On G-code segments and on the sampled stream alike;
+// the same change at a safe height raises nothing.
+TEST(CollisionChecks, AToolLoadedIntoTheStockIsReportedWhereItStands) {
+  const std::string head = "G21 G90\nT2 M6\nG43 H2\nS8000 M3\nG0 X20 Y20 Z";
+  const std::string tail = "\nT1 M6\nG43 H1\nG0 Z10\nG0 X50\nM2\n";
+  const app::Profile p = app::default_profile();
+  const double cylinder = std::numbers::pi * 25.0 * 8.0;
+  for (const bool sampled : {false, true}) {
+    const app::BatchResult r = sampled ? run_sampled(p, head + "2" + tail) : run(p, head + "2" + tail);
+    ASSERT_EQ(count_kind(r.events, verify::EventKind::ToolChangeInMaterial), 1u) << (sampled ? "sampled" : "segments");
+    const verify::Event* e = first_of(r.events, verify::EventKind::ToolChangeInMaterial);
+    EXPECT_EQ(e->tool, 1);
+    EXPECT_EQ(e->line, 8);  // the new tool's first move
+    EXPECT_NEAR(e->position.z, -8.0, 0.01);
+    EXPECT_NEAR(e->depth_mm, 8.0, 0.05);
+    EXPECT_NEAR(e->volume_mm3, cylinder, 0.005 * cylinder);
+    EXPECT_NEAR(r.removed_volume_mm3, e->volume_mm3, 0.005 * cylinder);
+    const app::BatchResult safe = sampled ? run_sampled(p, head + "20" + tail) : run(p, head + "20" + tail);
+    EXPECT_EQ(count_kind(safe.events, verify::EventKind::ToolChangeInMaterial), 0u);
+    EXPECT_EQ(safe.removed_volume_mm3, 0.0);
+  }
+}

@@ -119,10 +119,12 @@ void SampleStream::take(int channel, std::uint64_t seq, int tool, std::span<cons
   const std::uint64_t dseq = seq - c.seq;
   c.seq = seq;
   const ToolRef t = tool >= 0 ? tools_.find(tool) : default_tool_;
-  if (c.have && !t.same(c.tool)) {  // tool change: the pending run belongs to the old tool
-    flush(c);
-    c.tool = t;
-    restart(c, k, c.q);
+  if (c.have && !t.same(c.tool)) {  // tool change: the pending run belongs to the old tool,
+    flush(c);                       // and the new one starts where this sample puts it (as
+    c.tool = t;                     // nc::sampled_toolpath's ToolChange does), not with a
+    c.q = q;                        // sweep from where the old one was
+    restart(c, k, q);
+    return;
   }
   if (!c.have) {  // first sample: where the tool is; nothing to cut yet
     c.have = true;

@@ -74,6 +74,7 @@ const nc::Segment* MoveIndex::find(geom::MoveId id, const std::string** source) 
 
 CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::ToolTable& tools, const MoveIndex& index)
     : config_(config), index_(index) {
+  last_tool_.fill(-1);
   for (const auto& [number, tool] : tools.config().tools) {
     Parts p;
     p.shank_from_mm = tool.flute_length_mm + config.tolerance_mm;
@@ -112,7 +113,8 @@ int CollisionChecker::findings_of(const geom::LbrSolid& solid, const motion::Tim
   if (m.ref.shape == nullptr) return 0;  // tool 0: nothing cuts
   const auto parts = parts_.find(m.tool);
   const Parts* p = parts == parts_.end() ? nullptr : &parts->second;
-  const int n = segment_findings(solid, m, index_.find(m.ref.id, nullptr), rapid, out, 0);
+  int n = tool_change_finding(solid, m, out, 0);
+  n = segment_findings(solid, m, index_.find(m.ref.id, nullptr), rapid, out, n);
   return p != nullptr ? part_findings(solid, m, *p, out, n) : n;
 }
 
@@ -145,6 +147,17 @@ double probe_margin(const CheckConfig& c, const geom::LbrSolid& solid) noexcept 
   return c.tolerance_mm + 2.0 * solid.spec().chord_tol_mm;
 }
 }  // namespace
+
+int CollisionChecker::tool_change_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, Findings& out,
+                                          int n) {
+  if (m.channel < 0 || m.channel >= kChannels) return n;
+  const int before = last_tool_[static_cast<std::size_t>(m.channel)];
+  if (before < 0 || before == m.tool || m.ref.shape == nullptr) return n;
+  const Intrusion in = probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.from),
+                                      probe_margin(config_, solid), contact_only_);
+  if (in.deep_mm3 > 0.0) out[n++] = {EventKind::ToolChangeInMaterial, in};
+  return n;
+}
 
 Intrusion CollisionChecker::cutting_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m) {
   const double margin = probe_margin(config_, solid);
@@ -201,7 +214,7 @@ Event CollisionChecker::event_of(const motion::TimedSweep& m, const Finding& f) 
   e.move = m.ref.id;
   e.tool = m.tool;
   e.channel = m.channel;
-  e.position = m.ref.to.tip;
+  e.position = f.kind == EventKind::ToolChangeInMaterial ? m.ref.from.tip : m.ref.to.tip;  // where it stands
   e.volume_mm3 = f.what.volume_mm3;
   e.depth_mm = f.what.depth_mm;
   e.region = f.what.region;
@@ -253,6 +266,8 @@ std::size_t CollisionChecker::check_moves(const geom::LbrSolid& solid, std::span
       if (i == from && (kSweepKinds >> static_cast<unsigned>(found[k].kind) & 1u) != 0)
         settle_.push_back({at, found[k].what.volume_mm3});
     }
+    if (moves[i].channel >= 0 && moves[i].channel < kChannels)
+      last_tool_[static_cast<std::size_t>(moves[i].channel)] = moves[i].tool;  // judged: not asked again
   }
   contact_only_ = false;
   if (run_moves_ < 2) settle_.clear();

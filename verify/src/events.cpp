@@ -17,6 +17,7 @@ const char* to_string(EventKind k) noexcept {
     case EventKind::OverTravel: return "over-travel";
     case EventKind::DesignGouge: return "design-gouge";
     case EventKind::SpindleNoseInMaterial: return "spindle-nose-in-material";
+    case EventKind::ToolChangeInMaterial: return "tool-change-in-material";
   }
   return "?";
 }
@@ -32,7 +33,8 @@ Severity severity_of(EventKind k) noexcept {
     case EventKind::Plunge:
     case EventKind::OverTravel:
     case EventKind::DesignGouge:
-    case EventKind::SpindleNoseInMaterial: return Severity::Error;
+    case EventKind::SpindleNoseInMaterial:
+    case EventKind::ToolChangeInMaterial: return Severity::Error;
     case EventKind::FeedLimit: return Severity::Warning;
   }
   return Severity::Error;

@@ -5,7 +5,8 @@
 // of a milling tool, the shank (between the flutes' end and the gauge length, at the shank
 // diameter) and the holder (from the gauge length up, at the holder diameter), meeting
 // material (shank-in-material, holder-in-material), and the spindle nose above the holder
-// (spindle-nose-in-material, [checks] spindle_nose_*); a cutting sweep that removes material
+// (spindle-nose-in-material, [checks] spindle_nose_*); the tool just loaded standing in
+// material (tool-change-in-material); a cutting sweep that removes material
 // while the segment's spindle is off (spindle-off) or faster than the feed limit
 // (feed-limit); the centre core of a non-centre-cutting tool meeting material on a descent
 // steeper than the ramp limit (plunge-non-centre-cutting). Turning moves (geom::LatheSweep)
@@ -23,6 +24,7 @@
 // Setup-time and batch-time code: allocates; not for the real-time path.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -158,6 +160,10 @@ class CollisionChecker {
   // The findings of one move against `solid`; returns how many were written. `rapid`: 1 / 0
   // the move is / is not a rapid, -1 the move's program segment tells.
   int findings_of(const geom::LbrSolid& solid, const motion::TimedSweep& m, int rapid, Findings& out);
+  // tool-change-in-material: when `m` is its channel's first milling move with a tool other
+  // than the one before, the new tool standing at the move's start (a sweep of no length),
+  // written to out[n]; returns the new count.
+  int tool_change_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, Findings& out, int n);
   // Rapid, spindle-off and feed-limit (the cutting sweep; spindle and feed need the move's
   // program segment `seg`, which live streams lack: null), written from out[n]; returns the
   // new count.
@@ -176,6 +182,10 @@ class CollisionChecker {
                       double from_mm, EventKind kind, Finding& out);
   [[nodiscard]] Event event_of(const motion::TimedSweep& m, const Finding& f) const;
 
+  // Per channel, the tool of the last move judged (-1: none yet; channels from kChannels on
+  // are not followed). Fixed storage: the live checks run on the geometry thread.
+  static constexpr int kChannels = 16;
+  std::array<int, kChannels> last_tool_{};
   CheckConfig config_;
   const MoveIndex& index_;
   std::map<int, Parts> parts_;

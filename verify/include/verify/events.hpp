@@ -27,6 +27,7 @@ enum class EventKind : unsigned char {
   OverTravel,         // a move ends outside the machine's axis travel ([machine] travel_*)
   DesignGouge,        // the final stock lacks design material deeper than the design tolerance
   SpindleNoseInMaterial,  // the spindle nose above the holder ([checks] spindle_nose_*: mill5 heads) meets material
+  ToolChangeInMaterial,   // the tool just loaded stands in material (a longer tool changed near the part)
 };
 enum class Severity : unsigned char { Warning, Error };
 
