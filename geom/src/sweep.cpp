@@ -709,6 +709,19 @@ namespace {
 
 constexpr double kPointEps = 0.05;  // boundary points to tol/20 (of the chord tolerance)
 
+// The kDirs directions of the coarse points as unit vectors (cos, sin of 2πi/kDirs).
+const std::array<SectionScratch::P2, TiltedPiece::kDirs>& coarse_directions() noexcept {
+  static const std::array<SectionScratch::P2, TiltedPiece::kDirs> dirs = [] {
+    std::array<SectionScratch::P2, TiltedPiece::kDirs> d{};
+    for (int i = 0; i < TiltedPiece::kDirs; ++i) {
+      const double a = 2.0 * std::numbers::pi * i / TiltedPiece::kDirs;
+      d[static_cast<std::size_t>(i)] = {std::cos(a), std::sin(a)};
+    }
+    return d;
+  }();
+  return dirs;
+}
+
 // The boundary of the section of piece p's hull on its plane, as support points in angular
 // order (counter-clockwise) appended to sc.pts, starting from the piece's coarse points.
 // Between the support points a and b of directions φa < φb the boundary lies in the
@@ -764,7 +777,7 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
     Iv stack[64];
     int sp = 0;
     const double pb = di.phi + 2.0 * std::numbers::pi / kStart;
-    stack[sp++] = {di.phi, pb, {std::cos(di.phi), std::sin(di.phi)}, {std::cos(pb), std::sin(pb)}, di.p, dj.p, di.t_lo,
+    stack[sp++] = {di.phi, pb, coarse_directions()[static_cast<std::size_t>(i)], coarse_directions()[static_cast<std::size_t>(j)], di.p, dj.p, di.t_lo,
                    di.t_hi, dj.t_lo, dj.t_hi, 0};
     while (sp > 0) {
       const Iv iv = stack[--sp];
@@ -779,7 +792,10 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
       const double ca = 0.5 * (iv.ta_lo + iv.ta_hi), cb = 0.5 * (iv.tb_lo + iv.tb_hi);
       const double hw = std::max(0.125 * std::abs(ca - cb), 0.5 * std::max(iv.ta_hi - iv.ta_lo, iv.tb_hi - iv.tb_lo));
       double mlo = 0.5 * (ca + cb) - hw, mhi = 0.5 * (ca + cb) + hw;
-      const P2 um{std::cos(pm), std::sin(pm)};
+      // (cos pm, sin pm) without the trigonometry: the bisector of the ends' unit vectors
+      // (their angle is at most 2π/kStart, far below π).
+      const double bx = iv.ua.x + iv.ub.x, by = iv.ua.y + iv.ub.y, bl = std::sqrt(bx * bx + by * by);
+      const P2 um{bx / bl, by / bl};
       const P2 m = hull.section_point(um.x, um.y, zc, eps, mlo, mhi, kWarmSteps);
       if (dist_to_line(m, iv.a, iv.b) <= eps) {
         sc.pts.push_back(iv.a);
@@ -848,7 +864,8 @@ void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, cons
         thi += shift + h;
       }
     }
-    const P2 q = hull.section_point(phi, p.zc, eps, tlo, thi, min_steps);
+    const P2 u = coarse_directions()[static_cast<std::size_t>(i)];
+    const P2 q = hull.section_point(u.x, u.y, p.zc, eps, tlo, thi, min_steps);
     p.dirs[i] = {phi, q, tlo, thi};
   }
   p.edge_count = 0;
