@@ -115,23 +115,25 @@ void clip_pass(const Path& in, Path& out, Inside inside, Project project) {
       break;
     }
   if (start == n) return;  // wholly outside: no winding inside
+  // The k-th vertex from `start` (k < n), without a division per vertex.
+  auto at = [&](std::size_t k) -> const Point& { return in[start + k < n ? start + k : start + k - n]; };
   for (std::size_t k = 0; k < n;) {
-    const Point& p = in[(start + k) % n];
+    const Point& p = at(k);
     if (inside(p)) {
       out.push_back(p);
       ++k;
       continue;
     }
     std::size_t e = k;
-    while (e + 1 < n && !inside(in[(start + e + 1) % n])) ++e;
+    while (e + 1 < n && !inside(at(e + 1))) ++e;
     const Point& first = p;
-    const Point& last = in[(start + e) % n];
+    const Point& last = at(e);
     out.push_back(first);
     if (e - k >= 2) {
       out.push_back(project(first));
       out.push_back(project(last));
     } else if (e > k) {
-      out.push_back(in[(start + k + 1) % n]);
+      out.push_back(at(k + 1));
     }
     if (e - k >= 2) out.push_back(last);
     k = e + 1;
