@@ -666,13 +666,16 @@ bool trim_covered(Path& b, const Path& a, std::vector<std::uint8_t>& flags, doub
   // a is convex and counter-clockwise: the wedge from a[0] that holds q, then q's distance
   // to that wedge's edge and its neighbours (the edges a point near a vertex is nearest to).
   const Rect box = bounds_of(a);
-  auto side = [&](std::size_t i, const Point& q) {  // signed distance to edge i -> i+1 [units]
+  // q lies at least `margin` inside edge i -> i+1 (its signed distance c / |e| >= margin),
+  // compared squared for a positive margin (no square root per test).
+  auto beyond = [&](std::size_t i, const Point& q) {
     const Point& p0 = a[i];
     const Point& p1 = a[(i + 1) % na];
     const double ex = static_cast<double>(p1.X - p0.X), ey = static_cast<double>(p1.Y - p0.Y);
-    const double l = std::sqrt(ex * ex + ey * ey);  // integer units: no overflow, so not the slower hypot
+    const double l2 = ex * ex + ey * ey;  // integer units: no overflow
     const double c = ex * static_cast<double>(q.Y - p0.Y) - ey * static_cast<double>(q.X - p0.X);
-    return l > 0.0 ? c / l : c;
+    if (margin <= 0.0) return l2 > 0.0 ? c >= margin * std::sqrt(l2) : c >= margin;
+    return c > 0.0 && c * c >= margin * margin * l2;
   };
   auto cross0 = [&](std::size_t i, const Point& q) {
     return static_cast<double>(a[i].X - a[0].X) * static_cast<double>(q.Y - a[0].Y) -
@@ -687,7 +690,7 @@ bool trim_covered(Path& b, const Path& a, std::vector<std::uint8_t>& flags, doub
       if (cross0(mid, q) > 0.0) lo = mid;
       else hi = mid;
     }
-    return side(lo, q) >= margin && side((lo + na - 1) % na, q) >= margin && side(hi % na, q) >= margin;
+    return beyond(lo, q) && beyond((lo + na - 1) % na, q) && beyond(hi % na, q);
   };
   return trim_inside(b, flags, inside);
 }
