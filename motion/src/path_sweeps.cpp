@@ -76,7 +76,7 @@ void path_sweeps(const ToolTable& tools, const kin::Kinematics& k, const nc::Too
       // A tool change moves the tip without a motion (the gauge line stays where it is, the
       // new tool's length differs: docs/nc-frontend.md): the next motion starts from the new
       // tip, as the machine's (and the sampled stream's) does.
-      if (direct || s.has_tool_axis) pose.tip = pose_of(s.end, s.tool_axis).tip;
+      if (direct || s.has_tool_axis) pose.tip = {s.end[nc::X], s.end[nc::Y], s.end[nc::Z]};
       else pose = kin::tool_pose(k, s.end, tools.mount_of(s.tool));
       q = s.end;
       t = t_end;
