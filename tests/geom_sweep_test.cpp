@@ -332,7 +332,10 @@ TEST(Sweep, TiltedPiecesWithNeighbourCoversKeepTheUnionWithFewerVertices) {
   // cut by one plane through the ball and one through the shank. Each piece refined only
   // where neither neighbour's coarse polygon covers it (the engine's way) must give the same
   // union as every piece refined in full, with far fewer vertices.
-  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  auto bull = test::tool(ToolKind::Bull, 10);
+  bull.corner_radius_mm = 2.0;
+  const auto shape = geom::CutterShape::build(bull, kTol);
+  ASSERT_EQ(shape.capsule_radius_mm, 0.0);
   auto pose = [](int i) {
     const double a = (1.0 * i) * test::kPi / 180.0;
     return test::at(0.5 * i, 0, 0, {0, -std::sin(a), std::cos(a)});
@@ -411,15 +414,20 @@ TEST(Sweep, TiltedSectionVerticesLieOnTheEllipseWithinThePointAccuracy) {
 }
 
 TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
-  // A ball Ø6 raster along X in 0.5 mm moves whose tilt follows A = 20° sin(πx/27) (as
-  // finish5x's ball pass), cut by a plane through the ball. The coarse points of each piece
+  // A bull Ø10 R2 raster along X in 0.5 mm moves whose tilt follows A = 20° sin(πx/27),
+  // cut by a plane through the corner (a ball's capsule model takes one query per point;
+  // the figures below were measured on the ball Ø6 of finish5x's ball pass before it;
+  // this bull: 5.1 queries per coarse point, 3.5 per output vertex). The coarse points of each piece
   // start from the previous piece's bracket moved by its drift, the refined points from
   // their neighbours' brackets, and each search stops once its point is proven within
   // tol/20 of the boundary, each search bracketing from its middle first: measured 4.0
   // queries per coarse point and 3.4 per output vertex in all (4.5 and 3.95 without the
   // middle first; on finish5x's first 300 blocks the coarse points took 10.3 queries each
   // before this work, 4.2 of them widening a bracket left where the previous piece's was).
-  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  auto bull = test::tool(ToolKind::Bull, 10);
+  bull.corner_radius_mm = 2.0;
+  const auto shape = geom::CutterShape::build(bull, kTol);
+  ASSERT_EQ(shape.capsule_radius_mm, 0.0);
   auto pose = [](int i) {
     const double x = -13.5 + 0.5 * i, a = 20.0 * std::sin(test::kPi * x / 27.0) * test::kPi / 180.0;
     return test::at(x, 0, 0, {0, -std::sin(a), std::cos(a)});
@@ -446,6 +454,80 @@ TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
   const double per_vertex = static_cast<double>(coarse + sc.support_queries) / static_cast<double>(vertices);
   std::printf("pieces %zu, queries per coarse point %.2f, per vertex %.2f (%zu vertices)\n", pieces.size(), per_coarse,
               per_vertex, vertices);
-  EXPECT_LT(per_coarse, 4.5);
-  EXPECT_LT(per_vertex, 3.7);
+  EXPECT_LT(per_coarse, 5.6);
+  EXPECT_LT(per_vertex, 3.8);
+}
+
+namespace {
+
+// Distance [mm] from p to the parallelogram o + s·e + t·f (s, t in [0, 1]).
+double dist_to_parallelogram(const geom::Vec3& p, const geom::Vec3& o, const geom::Vec3& e, const geom::Vec3& f) {
+  auto seg = [&](const geom::Vec3& a, const geom::Vec3& d) {
+    const double t = std::clamp(geom::dot(p - a, d) / geom::dot(d, d), 0.0, 1.0);
+    return geom::norm(p - (a + t * d));
+  };
+  // Inside the face: solve for (s, t) in the face's plane.
+  const double ee = geom::dot(e, e), ef = geom::dot(e, f), ff = geom::dot(f, f);
+  const geom::Vec3 w = p - o;
+  const double we = geom::dot(w, e), wf = geom::dot(w, f), det = ee * ff - ef * ef;
+  if (det > 1e-18) {
+    const double s = (we * ff - wf * ef) / det, t = (wf * ee - we * ef) / det;
+    if (s >= 0.0 && s <= 1.0 && t >= 0.0 && t <= 1.0) return geom::norm(w - (s * e + t * f));
+  }
+  return std::min({seg(o, e), seg(o, f), seg(o + e, f), seg(o + f, e)});
+}
+
+// The area [mm²] of {(x, y): dist((x, y, z), parallelogram) <= r}, row by row (the set is
+// convex: each row is one interval, found by bisection from the row's nearest point).
+double capsule_sweep_slice_area(const geom::Vec3& o, const geom::Vec3& e, const geom::Vec3& f, double r, double z,
+                                double y0, double y1, double x0, double x1, double dy) {
+  double area = 0.0;
+  for (double y = y0 + 0.5 * dy; y < y1; y += dy) {
+    auto d = [&](double x) { return dist_to_parallelogram({x, y, z}, o, e, f); };
+    double a = x0, b = x1;  // golden-section search for the row's nearest point
+    for (int i = 0; i < 200 && b - a > 1e-10; ++i) {
+      const double m1 = a + 0.382 * (b - a), m2 = a + 0.618 * (b - a);
+      if (d(m1) < d(m2)) b = m2;
+      else a = m1;
+    }
+    const double xm = 0.5 * (a + b);
+    if (d(xm) > r) continue;
+    auto edge = [&](double in, double out) {
+      for (int i = 0; i < 80; ++i) {
+        const double m = 0.5 * (in + out);
+        (d(m) <= r ? in : out) = m;
+      }
+      return 0.5 * (in + out);
+    };
+    area += (edge(xm, x1) - edge(xm, x0)) * dy;
+  }
+  return area;
+}
+
+}  // namespace
+
+TEST(Sweep, TiltedBallSectionsMatchTheExactSliceOfTheCapsuleSweep) {
+  // A ball Ø6 tilted 20° about X, moving 2 mm in X and 0.6 mm down with a fixed axis: its
+  // cutting part (ball and flutes' cylinder, CutterShape::capsule_radius_mm) sweeps the
+  // points within 3 mm of the parallelogram of its axis segment (centre to top of the flutes)
+  // and the move. The sections' areas against that set's, row by row (an independent
+  // reference); the polygons' vertices lie on the exact boundary, so each area may fall
+  // short only by the chord segments: measured 0.5–2.8 µm² short (about tol/10 times the
+  // perimeter), where the station model (the ball's profile as a polyline, each point found
+  // by bisection) fell 2.5–13.8 µm² short, up to tol·perimeter at z = 0.4.
+  const double a = 20.0 * test::kPi / 180.0;
+  const geom::Vec3 ax{0, -std::sin(a), std::cos(a)};
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  ASSERT_DOUBLE_EQ(shape.capsule_radius_mm, 3.0);
+  const geom::Pose p0 = test::at(0, 0, 0, ax), p1 = test::at(2, 0, -0.6, ax);
+  const geom::Sweep s(shape, p0, p1);
+  const geom::Vec3 o = p0.tip + 3.0 * ax, e = (shape.height() - 3.0) * ax, f = p1.tip - p0.tip;
+  for (double z : {-0.5, 0.4, 1.5, 3.2, 5.0}) {
+    const double ref = capsule_sweep_slice_area(o, e, f, 3.0, z, -12.0, 6.0, -6.0, 8.0, 0.001);
+    const double got = section_area_mm2(s, z);
+    const double perimeter = 2.0 * std::sqrt(test::kPi * ref) * 1.2;  // a circle's, with room for the elongation
+    std::printf("z %.2f: reference %.6f, section %.6f mm2 (%+.6f)\n", z, ref, got, got - ref);
+    EXPECT_LE(got, ref + 2e-4) << z;
+    EXPECT_GE(got, ref - 0.25 * kTol * perimeter) << z;
+  }
 }

@@ -100,13 +100,38 @@ int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
 // not +: the best station is the first whose step to the next does not increase the value.
 // Consecutive queries come from close directions, so it is found by walking from the last
 // query's station (one or two steps) rather than by a binary search; the result is the same.
+//
+// A ball end mill whose shank is no thinner than its head (CutterShape::capsule_radius_mm)
+// is taken as a capsule instead: the points within its radius r of the axis segment from the
+// ball's centre to the top of the flutes. That is the ball and the flutes' cylinder exactly;
+// only the cylinder's flat top becomes a hemisphere, which lies inside the shank above it.
+// The sub-step's hull is then Q ⊕ B(r), Q the tetrahedron of the two poses' segment ends,
+// and its section has a closed-form support point in every direction (capsule_point()).
 struct Hull3 {
+  Hull3(const CutterShape* s, const Pose& a, const Pose& b) noexcept : shape(s), pose{a, b} {
+    cap_r = s->capsule_radius_mm;
+    if (cap_r <= 0.0) return;
+    const double top = s->height();
+    q[0] = a.tip + cap_r * a.axis;
+    q[1] = a.tip + top * a.axis;
+    q[2] = b.tip + cap_r * b.axis;
+    q[3] = b.tip + top * b.axis;
+  }
   const CutterShape* shape;
   Pose pose[2];
+  double cap_r = 0.0;  // > 0: the capsule model (q: the segment ends at both poses)
+  Vec3 q[4];  // a.centre, a.top, b.centre, b.top
   mutable std::size_t last_station[2] = {0, 0};  // each pose's best station of the last query
   mutable std::uint32_t queries = 0;              // support() calls (TiltedPiece, SectionScratch)
   Vec3 support(const Vec3& d) const noexcept {
     ++queries;
+    if (cap_r > 0.0) {
+      int best = 0;
+      for (int i = 1; i < 4; ++i)
+        if (dot(q[i], d) > dot(q[best], d)) best = i;
+      const double l = norm(d);
+      return l > 0.0 ? q[best] + (cap_r / l) * d : q[best];
+    }
     const auto& st = shape->stations;
     double best = -INFINITY;
     Vec3 bp{};
@@ -151,6 +176,7 @@ struct Hull3 {
   // The same with the in-plane direction given as (ux, uy) = (cos φ, sin φ).
   P2 section_point(double ux, double uy, double zc, double eps, double& t_lo, double& t_hi,
                    int min_steps) const noexcept {
+    if (cap_r > 0.0) return capsule_point(ux, uy, zc);
     // Every query also bounds the section's support value h_S(u) from above: any point x of
     // the section (x.z = zc) has u·x + t·zc <= h_H(u, t), so h_S(u) <= g(t) = u·s + t·(s.z −
     // zc) with s the support point of (u, t).
@@ -164,7 +190,7 @@ struct Hull3 {
     // is within eps of u·P, P is within eps of the boundary's support line in direction u,
     // which is all that the refinement needs of it (refine_section()); then no further
     // step is taken whatever min_steps says.
-    auto proven = [&](const P2& q) { return upper - (ux * q.x + uy * q.y) <= eps; };
+    auto proven = [&](const P2& pt) { return upper - (ux * pt.x + uy * pt.y) <= eps; };
     double tlo = t_lo, thi = t_hi;
     // The middle first, then the end on the other side of the plane: the start bracket is
     // halved for the same two queries.
@@ -223,7 +249,52 @@ struct Hull3 {
     t_hi = thi;
     return last;
   }
+  P2 capsule_point(double ux, double uy, double zc) const noexcept;
 };
+
+// The capsule model's support point of the section on z = zc in direction u = (ux, uy):
+// the section of Q ⊕ B(r) is the hull of the sections of the balls swept along Q's six
+// edges (a slice of Q has its vertices on Q's edges), and along an edge p0 + s·d the
+// support value u·p(s) + sqrt(r² − (p(s).z − zc)²) is concave in s, greatest where its
+// derivative vanishes: p(s).z − zc = r·(u·d)·sgn(d.z) / sqrt(d.z² + (u·d)²), clamped to the
+// part of the edge within r of the plane. Exact up to rounding; one query.
+P2 Hull3::capsule_point(double ux, double uy, double zc) const noexcept {
+  ++queries;
+  const double r = cap_r;
+  double best = -INFINITY;
+  P2 bp{q[0].x, q[0].y};
+  auto edge = [&](const Vec3& p0, const Vec3& p1) {
+    const double dx = p1.x - p0.x, dy = p1.y - p0.y, dz = p1.z - p0.z;
+    const double b = ux * dx + uy * dy;
+    double s = 0.0;
+    if (std::abs(dz) <= 1e-12) {
+      if (std::abs(p0.z - zc) > r) return;
+      s = b > 0.0 ? 1.0 : 0.0;
+    } else {
+      double s0 = (zc - r - p0.z) / dz, s1 = (zc + r - p0.z) / dz;
+      if (s0 > s1) std::swap(s0, s1);
+      s0 = std::max(s0, 0.0);
+      s1 = std::min(s1, 1.0);
+      if (s0 > s1) return;
+      const double w = zc + r * b * (dz > 0.0 ? 1.0 : -1.0) / std::sqrt(dz * dz + b * b);
+      s = std::clamp((w - p0.z) / dz, s0, s1);
+    }
+    const double h = p0.z + s * dz - zc;
+    const double rho = std::sqrt(std::max(0.0, r * r - h * h));
+    const double v = ux * p0.x + uy * p0.y + s * b + rho;
+    if (v > best) {
+      best = v;
+      bp = {p0.x + s * dx + rho * ux, p0.y + s * dy + rho * uy};
+    }
+  };
+  edge(q[0], q[1]);
+  edge(q[2], q[3]);
+  edge(q[0], q[2]);
+  edge(q[1], q[3]);
+  edge(q[0], q[3]);
+  edge(q[1], q[2]);
+  return bp;
+}
 
 double dist_to_line(const P2& p, const P2& a, const P2& b) noexcept {
   const double dx = b.x - a.x, dy = b.y - a.y;
@@ -921,7 +992,7 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
       zhi = std::max(zhi, circles[i].c.z + e);
     }
     if (zc < zlo || zc > zhi) continue;
-    const Hull3 hull{&s, {pa, b}};
+    const Hull3 hull(&s, pa, b);
     if (material != nullptr && beside_material(hull, circles, nc, *material)) continue;
     const bool warm = !out.empty() && out.back().zc == zc;
     out.emplace_back();
@@ -939,7 +1010,7 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
 
 std::size_t Sweep::build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
                                SectionScratch& sc) const {
-  const Hull3 hull{shape_, {p.a, p.b}};
+  const Hull3 hull(shape_, p.a, p.b);
   refine_section(hull, p, shape_->chord_tol_mm, cover0, cover1, sc);
   sc.support_queries += hull.queries;
   convex_hull(sc.pts, sc.hull);

@@ -141,6 +141,8 @@ CutterShape CutterShape::build(const Tool& tool, double chord_tol_mm) {
     }
   }
   if (s.stations.back().h < top) s.stations.push_back({top, s.stations.back().r});
+  const bool shank_covers = tool.shank_diameter_mm == 0.0 || tool.shank_diameter_mm >= tool.diameter_mm;
+  if (tool.kind == ToolKind::Ball && top >= r && shank_covers) s.capsule_radius_mm = r;
   return s;
 }
 

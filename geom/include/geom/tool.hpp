@@ -58,6 +58,11 @@ struct CutterShape {
   Tool tool;
   std::vector<Station> stations;  // strictly increasing h, from 0 to flute_length
   double chord_tol_mm = 0.001;
+  // > 0 for a ball end mill whose flutes reach the ball's equator and whose shank is no
+  // thinner than the head: its radius. Tilted sweeps then take the cutting part as the
+  // capsule around the axis from the ball's centre to the top of the flutes (exact but for
+  // the flutes' flat top, which becomes a hemisphere inside the shank; geom/src/sweep.cpp).
+  double capsule_radius_mm = 0.0;
 
   static CutterShape build(const Tool& tool, double chord_tol_mm);
   [[nodiscard]] double radius() const noexcept { return 0.5 * tool.diameter_mm; }
