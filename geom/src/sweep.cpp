@@ -250,6 +250,19 @@ struct Hull3 {
     return last;
   }
   P2 capsule_point(double ux, double uy, double zc) const noexcept;
+
+ private:
+  // Q's edges near the plane of the last capsule query: p0 + s·(dx, dy, dz), s in [s0, s1]
+  // within r of it; `level`: dz = 0 (the support is at s0 or s1).
+  struct CapEdge {
+    Vec3 p0;
+    double dx, dy, dz, s0, s1, sgn, dz2;
+    bool level;
+  };
+  void prepare_capsule(double zc) const noexcept;
+  mutable double cap_zc = NAN;
+  mutable int cap_edges = 0;
+  mutable CapEdge cap_edge[6];
 };
 
 // The capsule model's support point of the section on z = zc in direction u = (ux, uy):
@@ -260,32 +273,46 @@ struct Hull3 {
 // part of the edge within r of the plane. Exact up to rounding; one query.
 P2 Hull3::capsule_point(double ux, double uy, double zc) const noexcept {
   ++queries;
+  if (!(zc == cap_zc)) prepare_capsule(zc);
   const double r = cap_r;
   double best = -INFINITY;
   P2 bp{q[0].x, q[0].y};
-  auto edge = [&](const Vec3& p0, const Vec3& p1) {
-    const double dx = p1.x - p0.x, dy = p1.y - p0.y, dz = p1.z - p0.z;
-    const double b = ux * dx + uy * dy;
-    double s = 0.0;
-    if (std::abs(dz) <= 1e-12) {
-      if (std::abs(p0.z - zc) > r) return;
-      s = b > 0.0 ? 1.0 : 0.0;
-    } else {
-      double s0 = (zc - r - p0.z) / dz, s1 = (zc + r - p0.z) / dz;
-      if (s0 > s1) std::swap(s0, s1);
-      s0 = std::max(s0, 0.0);
-      s1 = std::min(s1, 1.0);
-      if (s0 > s1) return;
-      const double w = zc + r * b * (dz > 0.0 ? 1.0 : -1.0) / std::sqrt(dz * dz + b * b);
-      s = std::clamp((w - p0.z) / dz, s0, s1);
-    }
-    const double h = p0.z + s * dz - zc;
+  for (int i = 0; i < cap_edges; ++i) {
+    const CapEdge& e = cap_edge[i];
+    const double b = ux * e.dx + uy * e.dy;
+    const double s = e.level ? (b > 0.0 ? e.s1 : e.s0)
+                             : std::clamp((zc + r * b * e.sgn / std::sqrt(e.dz2 + b * b) - e.p0.z) / e.dz, e.s0, e.s1);
+    const double h = e.p0.z + s * e.dz - zc;
     const double rho = std::sqrt(std::max(0.0, r * r - h * h));
-    const double v = ux * p0.x + uy * p0.y + s * b + rho;
+    const double v = ux * e.p0.x + uy * e.p0.y + s * b + rho;
     if (v > best) {
       best = v;
-      bp = {p0.x + s * dx + rho * ux, p0.y + s * dy + rho * uy};
+      bp = {e.p0.x + s * e.dx + rho * ux, e.p0.y + s * e.dy + rho * uy};
     }
+  }
+  return bp;
+}
+
+// The edges of Q that come within r of plane z = zc, each with the part of it that does.
+void Hull3::prepare_capsule(double zc) const noexcept {
+  cap_zc = zc;
+  cap_edges = 0;
+  const double r = cap_r;
+  auto edge = [&](const Vec3& p0, const Vec3& p1) {
+    CapEdge e{p0, p1.x - p0.x, p1.y - p0.y, p1.z - p0.z, 0.0, 1.0, 1.0, 0.0, false};
+    e.dz2 = e.dz * e.dz;
+    e.sgn = e.dz > 0.0 ? 1.0 : -1.0;
+    if (std::abs(e.dz) <= 1e-12) {
+      if (std::abs(p0.z - zc) > r) return;
+      e.level = true;
+    } else {
+      double s0 = (zc - r - p0.z) / e.dz, s1 = (zc + r - p0.z) / e.dz;
+      if (s0 > s1) std::swap(s0, s1);
+      e.s0 = std::max(s0, 0.0);
+      e.s1 = std::min(s1, 1.0);
+      if (e.s0 > e.s1) return;
+    }
+    cap_edge[cap_edges++] = e;
   };
   edge(q[0], q[1]);
   edge(q[2], q[3]);
@@ -293,7 +320,6 @@ P2 Hull3::capsule_point(double ux, double uy, double zc) const noexcept {
   edge(q[1], q[3]);
   edge(q[0], q[3]);
   edge(q[1], q[2]);
-  return bp;
 }
 
 double dist_to_line(const P2& p, const P2& a, const P2& b) noexcept {
