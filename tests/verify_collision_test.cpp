@@ -549,3 +549,23 @@ TEST(CollisionChecks, AToolLoadedIntoTheStockIsReportedWhereItStands) {
     EXPECT_EQ(safe.removed_volume_mm3, 0.0);
   }
 }
+
+TEST(CollisionChecks, ARetractAlongTheAxisOfATiltedBallCutIsClean) {
+  // finish5x's line ends: the tilted ball's last move turns the axis upright, then G0 Z20
+  // lifts the tool along its axis out of the cut it stands in. The tilted moves are sectioned
+  // as the exact capsule, the upright retract with the ball's profile polyline, which 12 µm
+  // above the tip is 38 µm wider than the sphere (its first station, within the chord
+  // tolerance normal to the surface, lies almost level). A margin taken in the plane reported
+  // that film as a rapid into material; the deep test is the tool moved inwards by the margin
+  // normal to its surface (CollisionChecker::Parts::inner). A rapid that does cut is still one.
+  app::Profile p = app::load_profile(std::string(LBR_SOURCE_DIR) + "/config/profiles/mill5-ac.toml");
+  app::apply_tool_override(p, "3:ball:6");
+  const std::string head = "G21 G90 G17 G94\nG0 A0 C0\nT3 M6\nG43 H3\nS15000 M3\nG0 Z20\n";
+  const app::BatchResult r = run(p, head + "G0 X26.5 Y4.1149 A1.1629\nG1 Z-8.619 F500\nG1 X27 Y4 Z-8.6621 A0\nG0 Z20\nM2\n");
+  EXPECT_EQ(count_kind(r.events, verify::EventKind::RapidIntoMaterial), 0u) << verify::describe(r.events.at(0));
+  EXPECT_GT(r.removed_volume_mm3, 200.0);
+  const app::BatchResult crash = run(p, head + "G0 X26.5 Y4.1149 A1.1629\nG1 Z-8.619 F500\nG1 X27 Y4 Z-8.6621 A0\nG0 Y8\nM2\n");
+  const verify::Event* e = first_of(crash.events, verify::EventKind::RapidIntoMaterial);
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->line, 10);
+}

@@ -38,6 +38,30 @@ geom::CutterShape cylinder(double diameter_mm, double length_mm, double chord_to
   return geom::CutterShape::build(t, chord_tol_mm);
 }
 
+// The cutting part of `t` moved inwards by `m` normal to its surface, as a tool whose tip lies
+// `raise` up the axis: every radius less m, a corner radius less m (none left: a sharp
+// corner), a cone's tip up by m / sin(half angle), the flutes' top down by m. False when
+// nothing of it is left.
+bool inner_tool(const geom::Tool& t, double m, geom::Tool& out, double& raise) {
+  out = t;
+  out.diameter_mm = t.diameter_mm - 2.0 * m;
+  raise = m;
+  switch (t.kind) {
+    case geom::ToolKind::Flat: break;
+    case geom::ToolKind::Ball: break;
+    case geom::ToolKind::Bull:
+      if (t.corner_radius_mm > m) out.corner_radius_mm = t.corner_radius_mm - m;
+      else out.kind = geom::ToolKind::Flat;
+      break;
+    case geom::ToolKind::Drill:
+    case geom::ToolKind::VBit: raise = m / std::sin(0.5 * t.angle_deg * std::numbers::pi / 180.0); break;
+  }
+  out.flute_length_mm = t.flute_length_mm - m - raise;
+  out.length_mm = std::max(out.length_mm, out.flute_length_mm);
+  out.shank_diameter_mm = 0.0;
+  return out.diameter_mm > 0.0 && out.flute_length_mm > 0.0 && out.validate().empty();
+}
+
 // The angle of the tip's descent along the tool axis from the plane normal to the axis [deg]
 // (90: a straight plunge); 0 when the move does not descend.
 double descent_deg(const geom::Pose& from, const geom::Pose& to) {
@@ -89,6 +113,9 @@ CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::Tool
       p.nose = cylinder(config.spindle_nose_diameter_mm, config.spindle_nose_length_mm, tools.chord_tol_mm());
     }
     p.centre_cutting = tool.centre_cutting;
+    geom::Tool inner;
+    p.has_inner = inner_tool(tool, config.tolerance_mm + 2.0 * tools.chord_tol_mm(), inner, p.inner_raise_mm);
+    if (p.has_inner) p.inner = geom::CutterShape::build(inner, tools.chord_tol_mm());
     if (!p.centre_cutting)
       p.core = cylinder(kNonCuttingCoreFraction * tool.diameter_mm, tool.flute_length_mm, tools.chord_tol_mm());
     parts_.emplace(number, std::move(p));
@@ -153,8 +180,7 @@ int CollisionChecker::tool_change_finding(const geom::LbrSolid& solid, const mot
   if (m.channel < 0 || m.channel >= kChannels) return n;
   const int before = last_tool_[static_cast<std::size_t>(m.channel)];
   if (before < 0 || before == m.tool || m.ref.shape == nullptr) return n;
-  const Intrusion in = probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.from),
-                                      probe_margin(config_, solid), contact_only_);
+  const Intrusion in = tool_intrusion(solid, m, m.ref.from, m.ref.from);
   if (in.deep_mm3 > 0.0) out[n++] = {EventKind::ToolChangeInMaterial, in};
   return n;
 }
@@ -163,7 +189,18 @@ Intrusion CollisionChecker::cutting_intrusion(const geom::LbrSolid& solid, const
   const double margin = probe_margin(config_, solid);
   if (m.ref.turning != nullptr)
     return probe_.measure(solid, lathe_sweep(*m.ref.turning, m.ref, {0.0, 0.0}), margin, contact_only_);
-  return probe_.measure(solid, geom::Sweep(*m.ref.shape, m.ref.from, m.ref.to), margin, contact_only_);
+  return tool_intrusion(solid, m, m.ref.from, m.ref.to);
+}
+
+Intrusion CollisionChecker::tool_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m,
+                                           const geom::Pose& from, const geom::Pose& to) {
+  const double margin = probe_margin(config_, solid);
+  const geom::Sweep sweep(*m.ref.shape, from, to);
+  const auto parts = parts_.find(m.tool);
+  if (parts == parts_.end() || !parts->second.has_inner) return probe_.measure(solid, sweep, margin, contact_only_);
+  const Parts& p = parts->second;
+  const geom::Sweep inner(p.inner, raised(from, p.inner_raise_mm), raised(to, p.inner_raise_mm));
+  return probe_.measure(solid, sweep, margin, contact_only_, &inner);
 }
 
 int CollisionChecker::holder_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, const InsertHolder& h,

@@ -54,6 +54,7 @@ double area_mm2(const geom::Paths& paths) {
 // A milling sweep, or a turning sweep (and its shadow) over the stock's rectangle.
 struct IntrusionProbe::Source {
   const geom::Sweep* mill = nullptr;
+  const geom::Sweep* deep = nullptr;  // mill's tool moved inwards by the margin (or none)
   const geom::LatheSweep* lathe = nullptr;
   const geom::LatheSweep* shadow = nullptr;
   geom::Box3 bounds;
@@ -122,9 +123,10 @@ int IntrusionProbe::top_material_level(const geom::LbrSolid& solid, int from) co
 }
 
 Intrusion IntrusionProbe::measure(const geom::LbrSolid& solid, const geom::Sweep& sweep, double margin_mm,
-                                  bool contact_only) {
+                                  bool contact_only, const geom::Sweep* deep) {
   Source src;
   src.mill = &sweep;
+  src.deep = deep;
   src.bounds = sweep.bounds();
   return measure_source(solid, src, margin_mm, contact_only);
 }
@@ -161,7 +163,12 @@ bool IntrusionProbe::source_section(const geom::LbrSolid& solid, const Source& s
   return geom::LatheSweep::ring(ring_in_, ring_out_, tol, src.extent, section_) > 0;
 }
 
-void IntrusionProbe::source_shrunk(const Source& src, double margin_mm) {
+void IntrusionProbe::source_shrunk(const Source& src, double z_mm, double margin_mm) {
+  if (src.deep != nullptr) {
+    shrunk_.clear();
+    (void)src.deep->section(z_mm, shrunk_, scratch_);
+    return;
+  }
   if (src.mill != nullptr) return shrink_section(margin_mm);
   shrunk_.clear();
   const double in = ring_in_ > 0.0 ? ring_in_ + margin_mm : ring_in_;  // no hole: nothing to move
@@ -276,7 +283,7 @@ Intrusion IntrusionProbe::measure_source(const geom::LbrSolid& solid, const Sour
       region_volume_[k] += v;
       level_mm3 += v;
       if (out.deep_mm3 > 0.0) continue;  // a finding already: only the volume is still needed
-      if (!shrunk) source_shrunk(src, margin_mm), shrunk = true;
+      if (!shrunk) source_shrunk(src, z, margin_mm), shrunk = true;
       out.deep_mm3 += (whole ? area_mm2(shrunk_) : subject_overlap_mm2(shrunk_)) * solid.level_thickness_mm(level);
     }
     if (level_mm3 <= 0.0) continue;

@@ -135,6 +135,11 @@ class CollisionChecker {
     bool has_shank = false;
     bool has_nose = false;        // [checks] spindle_nose_diameter_mm set
     bool centre_cutting = true;   // false: `core` is the end face's non-cutting centre
+    // The cutting part moved inwards by the probe margin, normal to its surface, with its tip
+    // `inner_raise_mm` up the axis: the deep test of the cutting sweep (IntrusionProbe).
+    geom::CutterShape inner;
+    double inner_raise_mm = 0.0;
+    bool has_inner = false;       // false: the tool is too small for it (a margin in the plane)
   };
   // A turning tool's holder: its shape and where it sits from the insert's reference point.
   struct InsertHolder {
@@ -171,6 +176,10 @@ class CollisionChecker {
                        Findings& out, int n);
   // The material a move's cutting sweep (milling or turning) meets.
   [[nodiscard]] Intrusion cutting_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m);
+  // The material the tool of `m` meets swept from `from` to `to`, its deep test by the inner
+  // tool (Parts::inner) where it has one.
+  [[nodiscard]] Intrusion tool_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m, const geom::Pose& from,
+                                         const geom::Pose& to);
   // A turning move's holder, written to out[n]; returns the new count.
   int holder_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, const InsertHolder& h, Findings& out,
                      int n);

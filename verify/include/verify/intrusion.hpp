@@ -38,8 +38,13 @@ class IntrusionProbe {
   // deep_mm3 = 0).
   // With `contact_only`, the levels are walked from the bottom up only until the first deep
   // contact: deep_mm3 > 0 tells the same, volume_mm3 and depth_mm are those levels' only.
+  // With `deep` (the same move of the tool moved inwards by margin_mm in 3D, normal to its
+  // surface) the deep material is the material inside deep's sections instead: near a ball's
+  // bottom, where the surface is almost level, two polygonisations of one tool within the
+  // chord tolerance of it differ horizontally by many times that tolerance, and a margin
+  // taken in the plane would report the film one leaves inside the other.
   [[nodiscard]] Intrusion measure(const geom::LbrSolid& solid, const geom::Sweep& sweep, double margin_mm,
-                                  bool contact_only = false);
+                                  bool contact_only = false, const geom::Sweep* deep = nullptr);
   // The same for a turning sweep: the material inside its revolved region on each level.
   // With `shadow` (the same move's insert, when `sweep` is its holder) only the material
   // the shadow does not remove on that level counts: the insert leads its holder, so what
@@ -56,8 +61,9 @@ class IntrusionProbe {
   // sets ring_in_ / ring_out_ and meets_[k] (whether region regions_[k]'s cell may meet the
   // ring) first, and builds no polygon when no cell may meet it.
   bool source_section(const geom::LbrSolid& solid, const Source& src, int level, double z_mm);
-  // shrunk_ = the section moved inwards by the margin.
-  void source_shrunk(const Source& src, double margin_mm);
+  // shrunk_ = the section moved inwards by the margin (the deep sweep's section on plane z_mm
+  // when the source has one).
+  void source_shrunk(const Source& src, double z_mm, double margin_mm);
   // Whether any cell of regions_ on `level` may meet the ring ring_in_ … ring_out_ (fills
   // meets_): not when its farthest point from the axis stays inside r_in, or its box stays
   // outside r_out (within the circles' polygonisation, half the chord tolerance).
