@@ -84,10 +84,13 @@ std::size_t emit(const std::vector<P2>& hull, Paths& out, std::vector<Path>& spa
 // caller's fixed array of them (room for the largest profile) costs nothing to declare: with
 // Vec3's zero initialisers the 1 024 circles of tilted_pieces() were written on every call
 // (57 KB, 2/3 of its time on finish5x's ball pass).
+// A point without initialisers (see Circle).
+struct P3 {
+  double x, y, z;
+};
+P3 p3(const Vec3& v) noexcept { return {v.x, v.y, v.z}; }
+
 struct Circle {
-  struct P3 {
-    double x, y, z;
-  };
   P3 c, n;
   double r;
 };
@@ -121,25 +124,27 @@ struct Hull3 {
     cap_r = s->capsule_radius_mm;
     if (cap_r <= 0.0) return;
     const double top = s->height();
-    q[0] = a.tip + cap_r * a.axis;
-    q[1] = a.tip + top * a.axis;
-    q[2] = b.tip + cap_r * b.axis;
-    q[3] = b.tip + top * b.axis;
+    q[0] = p3(a.tip + cap_r * a.axis);
+    q[1] = p3(a.tip + top * a.axis);
+    q[2] = p3(b.tip + cap_r * b.axis);
+    q[3] = p3(b.tip + top * b.axis);
   }
   const CutterShape* shape;
   Pose pose[2];
   double cap_r = 0.0;  // > 0: the capsule model (q: the segment ends at both poses)
-  Vec3 q[4];  // a.centre, a.top, b.centre, b.top
+  P3 q[4];  // a.centre, a.top, b.centre, b.top (set only for the capsule: no initialisers)
   mutable std::size_t last_station[2] = {0, 0};  // each pose's best station of the last query
   mutable std::uint32_t queries = 0;              // support() calls (TiltedPiece, SectionScratch)
   Vec3 support(const Vec3& d) const noexcept {
     ++queries;
     if (cap_r > 0.0) {
+      auto along = [&](const P3& v) { return v.x * d.x + v.y * d.y + v.z * d.z; };
       int best = 0;
       for (int i = 1; i < 4; ++i)
-        if (dot(q[i], d) > dot(q[best], d)) best = i;
+        if (along(q[i]) > along(q[best])) best = i;
       const double l = norm(d);
-      return l > 0.0 ? q[best] + (cap_r / l) * d : q[best];
+      const Vec3 c{q[best].x, q[best].y, q[best].z};
+      return l > 0.0 ? c + (cap_r / l) * d : c;
     }
     const auto& st = shape->stations;
     double best = -INFINITY;
@@ -264,7 +269,7 @@ struct Hull3 {
   // Q's edges near the plane of the last capsule query: p0 + s·(dx, dy, dz), s in [s0, s1]
   // within r of it; `level`: dz = 0 (the support is at s0 or s1).
   struct CapEdge {
-    Vec3 p0;
+    P3 p0;
     double dx, dy, dz, s0, s1, sgn, dz2;
     bool level;
   };
@@ -307,7 +312,7 @@ void Hull3::prepare_capsule(double zc) const noexcept {
   cap_zc = zc;
   cap_edges = 0;
   const double r = cap_r;
-  auto edge = [&](const Vec3& p0, const Vec3& p1) {
+  auto edge = [&](const P3& p0, const P3& p1) {
     CapEdge e{p0, p1.x - p0.x, p1.y - p0.y, p1.z - p0.z, 0.0, 1.0, 1.0, 0.0, false};
     e.dz2 = e.dz * e.dz;
     e.sgn = e.dz > 0.0 ? 1.0 : -1.0;
