@@ -10,7 +10,8 @@
 // chord tolerance of the exact section. For a flat end mill the linear profile is exact, so
 // the only error is polygonisation. Moves whose axis changes are subdivided so that no
 // point of the tool leaves the chord tolerance of the linear interpolation between
-// sub-steps.
+// sub-steps. A tilted ball end mill (CutterShape::capsule_radius_mm) is taken as its exact
+// capsule instead of the profile polyline; its section points have a closed form.
 #pragma once
 
 #include <cstdint>
