@@ -42,6 +42,16 @@ void clip_half(const geom::Path& in, int axis, geom::Coord c, bool keep_greater,
   }
 }
 
+// Empties `paths`, keeping their buffers in `spare` (geom::Sweep::section() takes them from
+// there), up to a bound: the lathe's rings and the offsets in the plane come with buffers of
+// their own, which would otherwise pile up there.
+void recycle(geom::Paths& paths, std::vector<geom::Path>& spare) {
+  constexpr std::size_t kMaxSpare = 256;
+  for (geom::Path& p : paths)
+    if (spare.size() < kMaxSpare) spare.push_back(std::move(p));
+  paths.clear();
+}
+
 // Area of non-overlapping paths [mm²].
 double area_mm2(const geom::Paths& paths) {
   double units2 = 0.0;
@@ -104,7 +114,7 @@ double IntrusionProbe::subject_overlap_mm2(const geom::Paths& clip) {
 // Each convex section polygon moved inwards by the margin (pieces thinner than twice the
 // margin vanish).
 void IntrusionProbe::shrink_section(double margin_mm) {
-  shrunk_.clear();
+  recycle(shrunk_, scratch_.spare);
   geom::Paths piece;
   for (const geom::Path& p : section_) {
     offset_.Clear();
@@ -165,7 +175,7 @@ bool IntrusionProbe::source_section(const geom::LbrSolid& solid, const Source& s
 
 void IntrusionProbe::source_shrunk(const Source& src, double z_mm, double margin_mm) {
   if (src.deep != nullptr) {
-    shrunk_.clear();
+    recycle(shrunk_, scratch_.spare);
     (void)src.deep->section(z_mm, shrunk_, scratch_);
     return;
   }
@@ -263,7 +273,7 @@ Intrusion IntrusionProbe::measure_source(const geom::LbrSolid& solid, const Sour
     const bool material = std::any_of(regions_.begin(), regions_.end(),
                                       [&](int region) { return solid.cell(region, level).bbox.intersects(xy); });
     if (!material) continue;
-    section_.clear();
+    recycle(section_, scratch_.spare);
     if (!source_section(solid, src, level, z)) continue;
     const geom::Rect sb = rect_of(section_);
     double level_mm3 = 0.0;

@@ -100,6 +100,9 @@ struct MoveCaps {
 // (Sweep::build_piece()).
 struct TiltedPiece {
   static constexpr int kDirs = 16;
+  // Leaves dirs and edges unset (Sweep::tilted_pieces() writes them): a value-initialised
+  // piece would zero their 1 KB for every piece.
+  TiltedPiece() noexcept {}  // NOLINT(modernize-use-equals-default): = default would zero them in emplace_back()
   Pose a, b;  // the sub-step's poses
   double zc = 0.0;
   std::uint32_t sweep = 0;  // caller's index of the sweep it belongs to
