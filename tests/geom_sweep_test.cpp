@@ -16,6 +16,8 @@ using geom::ToolKind;
 namespace {
 
 constexpr double kTol = 0.001;  // chord tolerance [mm]
+// How far rounding a vertex to the unit grid can move it: half a unit diagonal [mm].
+const double kHalfUnitMm = 0.5 * std::sqrt(2.0) / geom::kUnitsPerMm;
 
 double section_area_mm2(const geom::Sweep& s, double z, std::size_t* count = nullptr) {
   geom::Paths out;
@@ -407,10 +409,9 @@ TEST(Sweep, TiltedSectionVerticesLieOnTheEllipseWithinThePointAccuracy) {
     inside_most = std::min(inside_most, f / g);
     outside_most = std::max(outside_most, f / g);
   }
-  const double half_unit = 0.5 * std::sqrt(2.0) / geom::kUnitsPerMm;
-  EXPECT_GE(inside_most, -(kTol / 20.0 + half_unit + 1e-6)) << out[0].size() << " vertices";
-  EXPECT_LE(outside_most, half_unit + 1e-6);
-  EXPECT_LT(inside_most, -0.1 * half_unit);  // the check sees the rounding, so it can see an error
+  EXPECT_GE(inside_most, -(kTol / 20.0 + kHalfUnitMm + 1e-6)) << out[0].size() << " vertices";
+  EXPECT_LE(outside_most, kHalfUnitMm + 1e-6);
+  EXPECT_LT(inside_most, -0.1 * kHalfUnitMm);  // the check sees the rounding, so it can see an error
 }
 
 TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
@@ -527,7 +528,28 @@ TEST(Sweep, TiltedBallSectionsMatchTheExactSliceOfTheCapsuleSweep) {
     const double got = section_area_mm2(s, z);
     const double perimeter = 2.0 * std::sqrt(test::kPi * ref) * 1.2;  // a circle's, with room for the elongation
     std::printf("z %.2f: reference %.6f, section %.6f mm2 (%+.6f)\n", z, ref, got, got - ref);
-    EXPECT_LE(got, ref + 2e-4) << z;
+    EXPECT_LE(got, ref + perimeter * kHalfUnitMm) << z;  // rounding to the unit grid
     EXPECT_GE(got, ref - 0.25 * kTol * perimeter) << z;
   }
+}
+
+TEST(Sweep, ABallLyingInTheLevelPlaneIsAStadium) {
+  // A ball Ø6 with flutes of 30 and its axis along +X (the capsule's axis segment level:
+  // the closed form's constant-height case): the capsule from the ball's centre (x = 3) to the
+  // top of the flutes (x = 30), radius 3, cut by z = h is the stadium of that segment and
+  // radius sqrt(9 − h²); its far cap (beyond x = 30) is the hemisphere that stands for the
+  // flutes' flat top (inside the shank). The polygon's vertices lie on the boundary, so its
+  // area falls short by at most the chord segments.
+  const auto shape = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  ASSERT_DOUBLE_EQ(shape.capsule_radius_mm, 3.0);
+  const geom::Sweep s(shape, test::at(0, 0, 0, {1, 0, 0}), test::at(0, 0, 0, {1, 0, 0}));
+  for (double h : {0.0, 1.0, 2.0, 2.9}) {
+    const double r = std::sqrt(9.0 - h * h), exact = 27.0 * 2.0 * r + test::kPi * r * r;
+    const double perimeter = 2.0 * 27.0 + 2.0 * test::kPi * r;
+    const double got = section_area_mm2(s, h);
+    std::printf("h %.1f: exact %.6f, section %.6f mm2 (%+.6f)\n", h, exact, got, got - exact);
+    EXPECT_LE(got, exact + perimeter * kHalfUnitMm) << h;  // rounding to the unit grid
+    EXPECT_GE(got, exact - 0.5 * kTol * perimeter) << h;
+  }
+  EXPECT_EQ(section_area_mm2(s, 3.01), 0.0);
 }
