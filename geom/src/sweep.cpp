@@ -80,16 +80,16 @@ std::size_t emit(const std::vector<P2>& hull, Paths& out, std::vector<Path>& spa
   return 1;
 }
 
-// A station circle of the tool at one pose. Plain doubles without initialisers, so that a
-// caller's fixed array of them (room for the largest profile) costs nothing to declare: with
-// Vec3's zero initialisers the 1 024 circles of tilted_pieces() were written on every call
-// (57 KB, 2/3 of its time on finish5x's ball pass).
-// A point without initialisers (see Circle).
+// A point of plain doubles without initialisers, so that a caller's fixed array of them
+// (Circle, Hull3's capsule) costs nothing to declare: with Vec3's zero initialisers the
+// 1 024 circles of tilted_pieces() were written on every call (57 KB, 2/3 of its time on
+// finish5x's ball pass).
 struct P3 {
   double x, y, z;
 };
 P3 p3(const Vec3& v) noexcept { return {v.x, v.y, v.z}; }
 
+// A station circle of the tool at one pose.
 struct Circle {
   P3 c, n;
   double r;
@@ -99,8 +99,7 @@ struct Circle {
 int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
   int n = 0;
   for (const auto& st : s.stations) {
-    const Vec3 c = p.tip + st.h * p.axis;
-    out[n++] = Circle{{c.x, c.y, c.z}, {p.axis.x, p.axis.y, p.axis.z}, st.r};
+    out[n++] = Circle{p3(p.tip + st.h * p.axis), p3(p.axis), st.r};
   }
   return n;
 }

@@ -47,7 +47,7 @@ bool inner_tool(const geom::Tool& t, double m, geom::Tool& out, double& raise) {
   out.diameter_mm = t.diameter_mm - 2.0 * m;
   raise = m;
   switch (t.kind) {
-    case geom::ToolKind::Flat: break;
+    case geom::ToolKind::Flat:
     case geom::ToolKind::Ball: break;
     case geom::ToolKind::Bull:
       if (t.corner_radius_mm > m) out.corner_radius_mm = t.corner_radius_mm - m;
@@ -61,6 +61,13 @@ bool inner_tool(const geom::Tool& t, double m, geom::Tool& out, double& raise) {
   out.shank_diameter_mm = 0.0;
   return out.diameter_mm > 0.0 && out.flute_length_mm > 0.0 && out.validate().empty();
 }
+
+// Material within this of a probe's boundary is not a finding: the configured tolerance
+// beyond what polygonisation alone can put there. The probe's section and the wall a
+// cut left are both polygons within ±chord tolerance of their circles, possibly on
+// different angle grids (a joined outline's, a single move's), so they may cross by up to
+// twice the chord tolerance where the exact surfaces touch (docs/verification.md).
+double probe_margin(const CheckConfig& c, double chord_tol_mm) noexcept { return c.tolerance_mm + 2.0 * chord_tol_mm; }
 
 // The angle of the tip's descent along the tool axis from the plane normal to the axis [deg]
 // (90: a straight plunge); 0 when the move does not descend.
@@ -114,7 +121,8 @@ CollisionChecker::CollisionChecker(const CheckConfig& config, const motion::Tool
     }
     p.centre_cutting = tool.centre_cutting;
     geom::Tool inner;
-    p.has_inner = inner_tool(tool, config.tolerance_mm + 2.0 * tools.chord_tol_mm(), inner, p.inner_raise_mm);
+    p.inner_margin_mm = probe_margin(config, tools.chord_tol_mm());
+    p.has_inner = inner_tool(tool, p.inner_margin_mm, inner, p.inner_raise_mm);
     if (p.has_inner) p.inner = geom::CutterShape::build(inner, tools.chord_tol_mm());
     if (!p.centre_cutting)
       p.core = cylinder(kNonCuttingCoreFraction * tool.diameter_mm, tool.flute_length_mm, tools.chord_tol_mm());
@@ -165,13 +173,8 @@ int CollisionChecker::segment_findings(const geom::LbrSolid& solid, const motion
 }
 
 namespace {
-// Material within this of a probe's boundary is not a finding: the configured tolerance
-// beyond what polygonisation alone can put there. The probe's section and the wall a
-// cut left are both polygons within ±chord tolerance of their circles, possibly on
-// different angle grids (a joined outline's, a single move's), so they may cross by up to
-// twice the chord tolerance where the exact surfaces touch (docs/verification.md).
 double probe_margin(const CheckConfig& c, const geom::LbrSolid& solid) noexcept {
-  return c.tolerance_mm + 2.0 * solid.spec().chord_tol_mm;
+  return probe_margin(c, solid.spec().chord_tol_mm);
 }
 }  // namespace
 
@@ -197,7 +200,10 @@ Intrusion CollisionChecker::tool_intrusion(const geom::LbrSolid& solid, const mo
   const double margin = probe_margin(config_, solid);
   const geom::Sweep sweep(*m.ref.shape, from, to);
   const auto parts = parts_.find(m.tool);
-  if (parts == parts_.end() || !parts->second.has_inner) return probe_.measure(solid, sweep, margin, contact_only_);
+  // The inner tool stands for this margin only (the tool table's chord tolerance is the
+  // solid's whenever both come from one profile).
+  if (parts == parts_.end() || !parts->second.has_inner || parts->second.inner_margin_mm != margin)
+    return probe_.measure(solid, sweep, margin, contact_only_);
   const Parts& p = parts->second;
   const geom::Sweep inner(p.inner, raised(from, p.inner_raise_mm), raised(to, p.inner_raise_mm));
   return probe_.measure(solid, sweep, margin, contact_only_, &inner);

@@ -139,6 +139,7 @@ class CollisionChecker {
     // `inner_raise_mm` up the axis: the deep test of the cutting sweep (IntrusionProbe).
     geom::CutterShape inner;
     double inner_raise_mm = 0.0;
+    double inner_margin_mm = 0.0;  // the margin it is moved inwards by
     bool has_inner = false;       // false: the tool is too small for it (a margin in the plane)
   };
   // A turning tool's holder: its shape and where it sits from the insert's reference point.
