@@ -17,6 +17,12 @@ constexpr std::size_t kCutSectionVertices = 16;
 // Margin of the box a clip path is cut to around the material it may touch [units].
 constexpr Coord kKeepMarginUnits = 16;
 
+// Windowed clips (window_clip.hpp): the window is the clip paths' box grown by this margin
+// [units], beyond the unit that rounding moves a crossing, so that no chord comes near a
+// vertex the difference makes; touched polygons with fewer vertices are clipped whole.
+constexpr Coord kWindowMarginUnits = 4;
+constexpr std::size_t kWindowMinVertices = 96;
+
 // The sections whose box meets the cell's content (ws.selected) and the cell's polygons
 // whose box meets those sections (ws.touched); false when either is empty.
 bool select_for_cell(const Cell& cell, const LevelSections& ls, SubtractWorkspace& ws) {
@@ -168,7 +174,73 @@ void replace_touched(Cell& cell, SubtractWorkspace& ws) {
   cell.polys.swap(ws.kept);
 }
 
+// The touched polygons' contours, whole, as the clip's subject.
+void add_subjects(const Cell& cell, SubtractWorkspace& ws) {
+  for (std::uint32_t p : ws.touched) {
+    ws.clipper.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
+    for (const Contour& h : cell.polys[p].holes) ws.clipper.AddPath(h.pts, ClipperLib::ptSubject, true);
+  }
+}
+
+// The touched contours reduced to the window of the clip paths (window_clip.hpp) as the
+// clip's subject; false, with nothing added, where that does not pay or is not safe. Tried
+// only where the window is small against the touched polygons and they have many vertices.
+bool add_windowed_subjects(const Cell& cell, const Rect& clip_box, SubtractWorkspace& ws) {
+  if (clip_box.empty()) return false;
+  Rect touched;
+  std::size_t vertices = 0;
+  ws.window.src.clear();
+  for (std::uint32_t p : ws.touched) {
+    const Polygon& poly = cell.polys[p];
+    touched.add(Point{poly.bbox.x0, poly.bbox.y0});
+    touched.add(Point{poly.bbox.x1, poly.bbox.y1});
+    ws.window.src.push_back(&poly.outer.pts);
+    vertices += poly.outer.pts.size();
+    for (const Contour& h : poly.holes) {
+      ws.window.src.push_back(&h.pts);
+      vertices += h.pts.size();
+    }
+  }
+  const Rect w{clip_box.x0 - kWindowMarginUnits, clip_box.y0 - kWindowMarginUnits, clip_box.x1 + kWindowMarginUnits,
+               clip_box.y1 + kWindowMarginUnits};
+  auto area = [](const Rect& r) { return static_cast<double>(r.x1 - r.x0) * static_cast<double>(r.y1 - r.y0); };
+  if (vertices < kWindowMinVertices || 4.0 * area(w) > area(touched) || !reduce_to_window(w, ws.window)) return false;
+  // Collinear vertices kept (a flag AddPath() reads): a chord in line with its neighbour
+  // stays an edge of its own; drop_slivers() takes out those the whole difference would not
+  // have.
+  ws.clipper.PreserveCollinear(true);
+  ws.clipper.AddPaths(ws.window.reduced, ClipperLib::ptSubject, true);
+  return true;
+}
+
 }  // namespace
+
+// The difference of the touched polygons and the selected sections into ws.tree: with the
+// polygons reduced to the sections' window where that pays, checked, and done again with the
+// whole polygons where the check fails (window_clip.hpp).
+void SubtractEngine::run_difference(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh,
+                                    SubtractWorkspace& ws, SubtractStats& stats) const {
+  ClipperLib::Clipper& c = ws.clipper;
+  c.Clear();
+  c.StrictlySimple(s_.spec_.strictly_simple);
+  const Rect clip_box = add_clip_paths(cell, region, ls, sh, ws);
+  const bool windowed = add_windowed_subjects(cell, clip_box, ws);
+  if (!windowed) add_subjects(cell, ws);
+  ws.tree.Clear();
+  c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  c.PreserveCollinear(false);
+  if (!windowed) return;
+  if (restore_runs(ws.tree, ws.window)) {
+    ++stats.clips_windowed;
+    return;
+  }
+  ++stats.window_fallbacks;
+  c.Clear();
+  (void)add_clip_paths(cell, region, ls, sh, ws);
+  add_subjects(cell, ws);
+  ws.tree.Clear();
+  c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+}
 
 Rect SubtractEngine::grown_region_rect(int region) const noexcept {
   const Rect rr = s_.region_rect(region);
@@ -182,30 +254,33 @@ Rect SubtractEngine::grown_region_rect(int region) const noexcept {
 // cut changes no vertex and no winding number. A joined outline runs along a whole pass and
 // a finishing pass mostly over material already removed, so most of its edges (its caps
 // over cleared levels, the stretch beyond the material) leave the clip. A chain enters as its
-// offset's piece for the region, cut the same way.
-void SubtractEngine::add_clip_paths(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh,
+// offset's piece for the region, cut the same way. Returns the box of the paths added.
+Rect SubtractEngine::add_clip_paths(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh,
                                     SubtractWorkspace& ws) const {
   ClipperLib::Clipper& c = ws.clipper;
   Rect keep;
   for (std::uint32_t p : ws.touched) keep.add(cell.polys[p].bbox);
   keep = Rect{keep.x0 - kKeepMarginUnits, keep.y0 - kKeepMarginUnits, keep.x1 + kKeepMarginUnits, keep.y1 + kKeepMarginUnits};
+  Rect added;
   auto add = [&](const Path& path) {
-    if (path.size() < kCutSectionVertices || contains(keep, bounds_of(path))) {
-      c.AddPath(path, ClipperLib::ptClip, true);
+    const Rect box = bounds_of(path);
+    if (path.size() < kCutSectionVertices || contains(keep, box)) {
+      if (c.AddPath(path, ClipperLib::ptClip, true)) added.add(box);
       return;
     }
     cut_to_rect(path, keep, ws.cut, ws.cut_tmp);
-    if (ws.cut.size() >= 3) c.AddPath(ws.cut, ClipperLib::ptClip, true);
+    if (ws.cut.size() >= 3 && c.AddPath(ws.cut, ClipperLib::ptClip, true)) added.add(bounds_of(ws.cut));
   };
   for (std::uint32_t k : ws.selected) {
     if (ls.chain[k] != kNoChain) {
       for (const Path& piece : offset_piece(sh, ls.chain[k], region, ws)) add(piece);
     } else if (ls.paths[k].size() < kCutSectionVertices || contains(keep, ls.box[k])) {
-      c.AddPath(ls.paths[k], ClipperLib::ptClip, true);
+      if (c.AddPath(ls.paths[k], ClipperLib::ptClip, true)) added.add(ls.box[k]);
     } else {
       add(ls.paths[k]);
     }
   }
+  return added;
 }
 
 // Clips one cell with the level's sections; true when the cell changed.
@@ -221,16 +296,7 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
     return false;
   }
 
-  ClipperLib::Clipper& c = ws.clipper;
-  c.Clear();
-  c.StrictlySimple(s_.spec_.strictly_simple);
-  for (std::uint32_t p : ws.touched) {
-    c.AddPath(cell.polys[p].outer.pts, ClipperLib::ptSubject, true);
-    for (const Contour& h : cell.polys[p].holes) c.AddPath(h.pts, ClipperLib::ptSubject, true);
-  }
-  add_clip_paths(cell, region, ls, sh, ws);
-  ws.tree.Clear();
-  c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  run_difference(cell, region, ls, sh, ws, stats);
   ++stats.cells_clipped;
   ws.fresh.clear();
   append_polygons(ws.tree, ws.fresh);

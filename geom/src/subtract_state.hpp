@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "clip_reach.hpp"
+#include "window_clip.hpp"
 #include "geom/lbr_solid.hpp"
 
 namespace lbr::geom::detail {
@@ -131,6 +132,7 @@ struct SubtractWorkspace {
   std::vector<std::uint32_t> selected, touched;
   std::vector<Polygon> fresh, kept;
   ReachScratch reach;               // material_out_of_reach()
+  WindowScratch window;             // windowed clips (window_clip.hpp)
 };
 
 }  // namespace lbr::geom::detail

@@ -114,6 +114,8 @@ struct SubtractStats {
   std::uint64_t sections_joined = 0;   // move sections written as part of a joined outline
   std::uint64_t outlines_star = 0;     // joined outlines of tight loops written as their outer chain only
   std::uint64_t cells_out_of_reach = 0;  // clips left out: no material within the sections' reach
+  std::uint64_t clips_windowed = 0;      // clips fed the cell's contours reduced to the clip's window
+  std::uint64_t window_fallbacks = 0;    // windowed clips done again with the whole contours
   SubtractStats& operator+=(const SubtractStats& o) noexcept {
     sections += o.sections; cells_tested += o.cells_tested;
     cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
@@ -121,6 +123,7 @@ struct SubtractStats {
     sections_in_air += o.sections_in_air; chain_offsets += o.chain_offsets;
     sections_joined += o.sections_joined; outlines_star += o.outlines_star;
     cells_out_of_reach += o.cells_out_of_reach;
+    clips_windowed += o.clips_windowed; window_fallbacks += o.window_fallbacks;
     return *this;
   }
 };
