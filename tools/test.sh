@@ -34,9 +34,9 @@ if [ "${LBR_SKIP_SANITIZERS:-0}" != "1" ]; then
   echo "== sanitizers: thread (ring, RT threads, live pipeline, kernel worker pool) =="
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DLBR_SANITIZE=thread -DLBR_TSAN_TESTS=ON \
         -DLBR_BUILD_BENCH=OFF -DLBR_BUILD_TESTS=ON
-  cmake --build build-tsan --parallel "$(nproc)" --target sched_ring_test sched_ring_test_tsan sched_stats_test app_live_test app_profile_test geom_parallel_test kin_machine_test app_snapshot_test app_watchdog_test
+  cmake --build build-tsan --parallel "$(nproc)" --target sched_ring_test sched_ring_test_tsan sched_stats_test app_live_test app_profile_test geom_parallel_test kin_machine_test app_snapshot_test app_watchdog_test app_live_pool_test
   TSAN_OPTIONS=halt_on_error=1 ctest --test-dir build-tsan --output-on-failure --timeout 900 \
-        -R '^(SpscRing|LatencyHistogram|RtThread|LiveRun|LiveProfile|Snapshot|Watchdog)\.|^Batch\.WorkerThreads|^ParallelSubtractor\.|^Channels\.|^sched_ring_test_tsan$'
+        -R '^(SpscRing|LatencyHistogram|RtThread|LiveRun|LiveProfile|LivePool|Snapshot|Watchdog)\.|^Batch\.WorkerThreads|^ParallelSubtractor\.|^Channels\.|^sched_ring_test_tsan$'
   if command -v clang++ >/dev/null 2>&1; then
     echo "== fuzzers (libFuzzer, fixed runs) =="
     CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLBR_BUILD_FUZZ=ON \

@@ -88,6 +88,8 @@ std::string live_metrics_json(const LiveResult& r, const Profile& profile) {
   j["overflow_capacity"] = r.overflow_capacity;
   j["kernel_calls"] = r.kernel_calls;
   j["sweeps_split"] = r.sweeps_split;
+  j["kernel_threads"] = r.kernel_threads;
+  j["kernel_calls_shared"] = r.kernel_calls_shared;
   j["samples_unapplied"] = r.samples_unapplied;
   j["stop_latency_ms"] = r.stop_latency_ms;
   j["wall_time_s"] = r.wall_time_s;

@@ -2,10 +2,13 @@
 
 #include "app/install_paths.hpp"
 
+#include <sched.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "cfg/table.hpp"
@@ -68,6 +71,7 @@ void read_lbr(cfg::Table& s, Profile& p) {
   geom::read_lbr(s, p.solid, p.regions_auto);
   p.batch_moves = static_cast<int>(s.integer("batch_moves", 512, 1, 100000));
   p.threads = static_cast<int>(s.integer("threads", 0, 0, 256));
+  p.live_threads = static_cast<int>(s.integer("live_threads", 1, 1, 256));
   read_live_grid(s, p);
 }
 
@@ -126,6 +130,15 @@ std::vector<double> split_numbers(const std::string& s, const std::string& what)
 }
 
 }  // namespace
+
+int live_kernel_threads(const Profile& p) noexcept {
+  if (p.live_threads <= 1) return 1;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  const int usable = sched_getaffinity(0, sizeof(set), &set) == 0 ? CPU_COUNT(&set)
+                                                                   : static_cast<int>(std::thread::hardware_concurrency());
+  return std::max(1, std::min(p.live_threads, usable));
+}
 
 void apply_regions(Profile& p, const std::string& spec, const std::string& where) {
   if (const std::string e = geom::apply_regions(spec, p.solid, p.regions_auto); !e.empty()) throw ProfileError(where + ": " + e);

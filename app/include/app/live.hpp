@@ -127,6 +127,8 @@ struct LiveResult {
   // (from the request being seen to the geometry thread's end) [ms].
   std::uint64_t samples_coalesced = 0, overflow_overruns = 0, overflow_high_water = 0, overflow_capacity = 0;
   std::uint64_t kernel_calls = 0, sweeps_split = 0, samples_unapplied = 0;
+  std::uint64_t kernel_calls_shared = 0;  // kernel calls that ran on the live kernel pool
+  int kernel_threads = 1;                 // threads of the live kernel pool (1: none)
   double stop_latency_ms = 0;
   std::vector<std::string> warnings{};  // as given to LiveOptions::on_warning
   // Snapshots written (periodic and final) and failed; resumed: the snapshot's generation

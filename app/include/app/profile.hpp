@@ -1,7 +1,7 @@
 // app/profile.hpp — machine profiles (TOML): the composition of every module's configuration.
 // Each module reads its own tables (docs/architecture.md, "Configuration"): geom [stock] and
 // [lbr]'s kernel keys, kin and nc [machine], nc [nc], motion [[tool]], hal and sched [live] and
-// [threads], gfx [render]; app/ reads [machine] name, [lbr] batch_moves / threads and
+// [threads], gfx [render]; app/ reads [machine] name, [lbr] batch_moves / threads / live_threads and
 // [[channel]], checks what spans modules, and rejects unknown keys. Every key is documented in
 // docs/profiles.md. Loading errors name file, line and key.
 #pragma once
@@ -47,6 +47,7 @@ struct Profile {
   bool regions_auto = false;   // [lbr] regions = "auto" (auto_region_grid)
   int batch_moves = 512;       // [lbr] moves per subtract() call in batch mode
   int threads = 0;             // [lbr] batch-mode kernel threads (0 = one per hardware thread)
+  int live_threads = 1;        // [lbr] kernel threads of `lbrsim run`'s long calls (live_kernel_threads())
   motion::ToolsConfig tooling; // [[tool]]: milling tools, lathe inserts, live-tool mounts (motion/config_toml.hpp)
   hal::LiveConfig live;        // [live], [[live.axis]], [threads]: `lbrsim run` (hal/config_toml.hpp)
   // [lbr] live_regions: the region grid of `lbrsim run`'s solid when it differs from
@@ -79,6 +80,10 @@ struct Profile {
 // Region grid for regions = "auto": an interim rule from stock size and tool diameter
 // (docs/profiles.md). Returns {nx, ny}.
 [[nodiscard]] std::pair<int, int> auto_region_grid(const geom::SolidSpec& solid, double max_tool_diameter_mm);
+
+// Threads of `lbrsim run`'s kernel pool, called on the geometry thread: [lbr] live_threads,
+// at most the processors that thread may run on (pinned by geometry_cpu: 1, no pool).
+[[nodiscard]] int live_kernel_threads(const Profile& p) noexcept;
 
 // Command-line overrides, with the syntax of `lbrsim batch --help`. Throw ProfileError.
 void apply_stock_override(Profile& p, const std::string& spec);

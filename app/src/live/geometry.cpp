@@ -119,8 +119,10 @@ bool Geometry::stop_due() noexcept {
 
 void Geometry::kernel(std::span<const geom::SweepRef> part, const Part& info) noexcept {
   const std::int64_t t_start = sched::now_ns();
-  const geom::SubtractStats st = solid_.subtract(part);
+  const bool shared = pool_ != nullptr && sizer_.predict_ns(info.units) >= pool_min_ns_;
+  const geom::SubtractStats st = shared ? pool_->subtract(solid_, part) : solid_.subtract(part);
   const std::int64_t took = sched::now_ns() - t_start;
+  if (shared) shared_calls_.store(shared_calls_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   work_.record(took);
   if (timed_) sizer_.observe(info.units, took);
   calls_.store(calls_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);

@@ -35,6 +35,7 @@
 #include "app/profile.hpp"
 #include "live/call_sizer.hpp"
 #include "geom/lbr_solid.hpp"
+#include "geom/parallel_subtractor.hpp"
 #include "live/checks.hpp"
 #include "gfx/exchange.hpp"
 #include "hal/sample.hpp"
@@ -94,6 +95,17 @@ class Geometry final : public motion::SweepSink {
     return {log_.data(), std::min(log_n_, log_.size())};
   }
   [[nodiscard]] double work_budget() const noexcept { return budget_; }
+  // Kernel calls predicted (CallSizer) to take at least `min_call_ns` run on `pool` (its
+  // threads and this one; byte for byte the same result) instead of on this thread alone:
+  // a shorter call would pay more for the hand-over than it gains. Null: every call here.
+  // The pool is used only by the thread that ticks, which sets it. Setup.
+  static constexpr std::int64_t kSharedCallNs = 500'000;
+  void set_pool(geom::ParallelSubtractor* pool, std::int64_t min_call_ns = kSharedCallNs) noexcept {
+    pool_ = pool;
+    pool_min_ns_ = static_cast<double>(min_call_ns);
+  }
+  // Kernel calls that ran on the pool (part of kernel_calls()).
+  [[nodiscard]] std::uint64_t kernel_calls_shared() const noexcept { return shared_calls_.load(std::memory_order_relaxed); }
   // Testing: sleep this long after every kernel call (a deliberately slowed kernel).
   void set_kernel_delay_ns(std::int64_t ns) noexcept { kernel_delay_ns_ = ns; }
   // Estimated work of one sweep alone (cells it reaches + its sections).
@@ -214,6 +226,9 @@ class Geometry final : public motion::SweepSink {
   bool abandoned_ = false;
   sched::LatencyHistogram lag_, work_, check_;
   std::atomic<std::uint64_t> applied_{0}, sweeps_{0}, batches_{0}, coalesced_{0}, calls_{0}, split_{0}, unapplied_{0};
+  std::atomic<std::uint64_t> shared_calls_{0};
+  geom::ParallelSubtractor* pool_ = nullptr;
+  double pool_min_ns_ = 0.0;
   std::atomic<double> removed_{0.0};
   int ticks_since_volume_ = 0;
   gfx::SolidExchange* ex_ = nullptr;

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 
 #include "app/batch.hpp"
@@ -51,6 +52,10 @@ struct LivePipeline::Impl {
   std::unique_ptr<RingSink> sink;
   std::unique_ptr<live::SkipSink> skip_sink;  // resumed replay: drops what the solid holds
   hal::SampleSink* input = nullptr;            // what the source delivers to
+  // The live kernel pool (Geometry::set_pool): made and destroyed by the geometry thread
+  // (start_kernel_pool()), so that its workers take that thread's policy and processors.
+  std::unique_ptr<geom::ParallelSubtractor> pool;
+  std::atomic<int> kernel_threads{1};
   std::unique_ptr<Geometry> geo;
   std::unique_ptr<live::LiveChecks> checks;  // collision checks on the geometry thread (null: off)
   std::shared_ptr<const nc::Emulator> emulator;        // an emulator source's (its plan)
@@ -312,9 +317,36 @@ void rest_until(const LivePipeline::Impl& p, std::int64_t due) noexcept {
     sched::sleep_until_ns(std::min(due, now + kRestSliceNs));
 }
 
+// The geometry thread's kernel pool (Geometry::set_pool, [lbr] live_threads > 1), made on
+// that thread once it is configured: its workers take its scheduling policy and priority
+// (SCHED_FIFO below the HAL thread; a SCHED_OTHER worker behind other processes' work held
+// the saturated geometry thread at the pool's barriers: finish5x lag p99 40 ms against 5.4
+// ms, docs/performance.md "Two kernel threads live") and its processors (pinned by
+// geometry_cpu: no pool). They work only inside the calls the pool takes, so each core keeps
+// the geometry thread's duty limit. Opt-in: on two cores a busy HAL thread (an emulator at
+// --speed 200) keeps the worker off its core, and the geometry thread waits for it.
+void start_kernel_pool(LivePipeline::Impl& p) {
+  const int n = live_kernel_threads(p.profile);
+  if (n < 2) return;
+  try {
+    p.pool = std::make_unique<geom::ParallelSubtractor>(n);
+  } catch (const std::system_error& e) {
+    spdlog::warn("live kernel: {} threads could not start ({}); one thread", n, e.what());
+    return;
+  }
+  p.geo->set_pool(p.pool.get());
+  p.kernel_threads.store(n, std::memory_order_relaxed);
+}
+
+void stop_kernel_pool(LivePipeline::Impl& p) noexcept {
+  p.geo->set_pool(nullptr);
+  p.pool.reset();
+}
+
 void geometry_thread(LivePipeline::Impl& p) {
   const hal::LiveConfig& cfg = p.profile.live;
   p.geo_mode = sched::configure_current_thread(cfg.geometry_thread) == sched::RtMode::Fifo ? 1 : 0;
+  start_kernel_pool(p);
   const std::size_t chunk = p.backpressure ? static_cast<std::size_t>(p.profile.batch_moves) : p.ring->capacity();
   const std::int64_t idle_ns = static_cast<std::int64_t>(cfg.geometry_idle_us) * 1000;
   const bool duty_limited = !p.backpressure && cfg.geometry_duty < 1.0;
@@ -343,6 +375,7 @@ void geometry_thread(LivePipeline::Impl& p) {
     if (finished && p.ring->front() == nullptr) break;
     sched::sleep_until_ns(sched::now_ns() + idle_ns);
   }
+  stop_kernel_pool(p);
   const bool stopping = p.stop_ns.load(std::memory_order_relaxed) != 0;
   if (stopping) (void)p.geo->discard();
   // The final state must reach the render side: retry while it is busy (bounded: 2 s, or
@@ -429,6 +462,8 @@ void snapshot(LivePipeline::Impl& p) {
   r.overflow_capacity = p.sink->overflow_capacity();
   r.kernel_calls = p.geo->kernel_calls();
   r.sweeps_split = p.geo->sweeps_split();
+  r.kernel_calls_shared = p.geo->kernel_calls_shared();
+  r.kernel_threads = p.kernel_threads.load(std::memory_order_relaxed);
   r.samples_unapplied = p.geo->unapplied() + p.hal_abandoned.load(std::memory_order_relaxed);
   r.samples_lost = p.source_lost.load(std::memory_order_relaxed) + r.samples_rejected + r.ring_overruns + r.overflow_overruns;
   const auto ms = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-6; };

@@ -5,12 +5,13 @@
 // together, taking work from shared counters; runs of equal levels are clipped once. The
 // result is byte for byte that of LbrSolid::subtract() for every thread count.
 //
-// Threads: the object is made, used and destroyed by one thread (the caller), which works
-// as worker 0; the workers live as long as the object and touch only the solid handed to
-// the current call. Between calls they spin for up to 200 µs, then sleep.
+// Threads: the object is used by one thread at a time (the caller), which works as worker
+// 0, and made and destroyed while no call runs. The workers take the scheduling policy of
+// the thread that makes the object, live as long as the object and touch only the solid
+// handed to the current call. Between calls they spin for up to 200 µs, then sleep.
 // Not real-time safe: every call allocates (Clipper; buffers grow to the largest batch) and
-// blocks until the workers are done. For the offline runner; the live geometry thread calls
-// LbrSolid::subtract() on its own.
+// blocks until the workers are done. For the offline runner, and for the live geometry
+// thread's long calls (app/src/live/geometry.cpp; its short ones call LbrSolid::subtract()).
 #pragma once
 
 #include <functional>
