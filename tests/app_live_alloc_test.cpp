@@ -23,6 +23,7 @@
 #include "hal/serial_codec.hpp"
 #include "hal/validate.hpp"
 #include "live/geometry.hpp"
+#include "live_geometry_rig.hpp"
 #include "live/ring_sink.hpp"
 #include "motion/sample_stream.hpp"
 #include "motion/tool_table.hpp"
@@ -34,15 +35,8 @@ using namespace lbr;
 
 using test::allocations;
 
-hal::AxisSample sample(std::uint64_t seq, double x, double y, double z, int tool = 1) {
-  hal::AxisSample s;
-  s.seq = seq;
-  s.t_rx_ns = static_cast<std::int64_t>(seq) * 1'000'000;
-  s.mask = 0x3F;
-  s.tool = static_cast<std::int16_t>(tool);
-  s.q = {x, y, z, 0, 0, 0};
-  return s;
-}
+using test::GeometryRig;
+using test::sample;
 
 TEST(LiveRealTime, SerialDecodeValidateAndRingDoNotAllocate) {
   const app::Profile profile = app::default_profile();
@@ -154,24 +148,6 @@ TEST(LiveRealTime, MotionStreamDoesNotAllocate) {
   EXPECT_EQ(allocations() - before, 0) << "the motion stream allocated";
   EXPECT_GT(sink.sweeps, 100);
 }
-
-struct GeometryRig {
-  app::Profile profile = app::default_profile();
-  geom::LbrSolid solid{profile.solid};
-  motion::ToolTable tools{profile.tooling, profile.solid.chord_tol_mm, profile.source};
-  sched::SpscRing<hal::AxisSample> ring{4096};
-  std::unique_ptr<app::live::Geometry> geo;
-  std::uint64_t seq = 0;
-  GeometryRig() {
-    tools.build_all();
-    geo = std::make_unique<app::live::Geometry>(solid, profile, tools, 1, ring, 0.001);
-  }
-  // A straight pass along X at y, z: `n` samples 0.1 mm apart, then one tick.
-  std::size_t pass(double y, double z, int n) {
-    for (int i = 0; i < n; ++i) (void)ring.try_push(sample(seq++, 10.0 + 0.1 * i, y, z));
-    return geo->tick(4096);
-  }
-};
 
 TEST(LiveRealTime, GeometryTickInTheAirDoesNotAllocate) {
   GeometryRig rig;

@@ -12,57 +12,37 @@
 #include "geom/parallel_subtractor.hpp"
 #include "geom/serialize.hpp"
 #include "live/geometry.hpp"
-#include "motion/tool_table.hpp"
+#include "live_geometry_rig.hpp"
 
 namespace {
 
 using namespace lbr;
 
-hal::AxisSample sample(std::uint64_t seq, double x, double y, double z) {
-  hal::AxisSample s;
-  s.seq = seq;
-  s.t_rx_ns = static_cast<std::int64_t>(seq) * 1'000'000;
-  s.mask = 0x3F;
-  s.tool = 1;
-  s.q = {x, y, z, 0, 0, 0};
-  return s;
+using test::GeometryRig;
+using test::sample;
+
+// Ramps and zig-zags through the stock (T1, a 10 mm flat end mill): sweeps that reach many
+// levels and regions, in ticks of 150 samples.
+void cut(GeometryRig& rig) {
+  for (int pass = 0; pass < 6; ++pass) {
+    const double y = 15.0 + 9.0 * pass;
+    for (int i = 0; i < 600; ++i) {
+      const double x = pass % 2 == 0 ? 5.0 + 0.15 * i : 95.0 - 0.15 * i;
+      const double z = -1.0 - 4.0 * (i / 600.0) - 0.5 * pass;
+      ASSERT_TRUE(rig.ring.try_push(sample(rig.seq++, x, y, z)));
+      if (i % 150 == 149) (void)rig.geo->tick(4096);
+    }
+  }
+  (void)rig.geo->tick(4096);
 }
 
-// A geometry thread's Geometry over the default profile's stock, fed by hand.
-struct Rig {
-  app::Profile profile = app::default_profile();
-  geom::LbrSolid solid{profile.solid};
-  motion::ToolTable tools{profile.tooling, profile.solid.chord_tol_mm, profile.source};
-  sched::SpscRing<hal::AxisSample> ring{4096};
-  std::unique_ptr<app::live::Geometry> geo;
-  std::uint64_t seq = 0;
-  Rig() {
-    tools.build_all();
-    geo = std::make_unique<app::live::Geometry>(solid, profile, tools, 1, ring, 0.001);
-  }
-  // Ramps and zig-zags through the stock (T1, a 10 mm flat end mill): sweeps that reach
-  // many levels and regions, in ticks of 150 samples.
-  void cut() {
-    for (int pass = 0; pass < 6; ++pass) {
-      const double y = 15.0 + 9.0 * pass;
-      for (int i = 0; i < 600; ++i) {
-        const double x = pass % 2 == 0 ? 5.0 + 0.15 * i : 95.0 - 0.15 * i;
-        const double z = -1.0 - 4.0 * (i / 600.0) - 0.5 * pass;
-        ASSERT_TRUE(ring.try_push(sample(seq++, x, y, z)));
-        if (i % 150 == 149) (void)geo->tick(4096);
-      }
-    }
-    (void)geo->tick(4096);
-  }
-};
-
 TEST(LivePool, SharedCallsLeaveTheSameSolidAsOneThread) {
-  Rig alone;
-  alone.cut();
+  GeometryRig alone;
+  cut(alone);
   geom::ParallelSubtractor pool(2);
-  Rig shared;
+  GeometryRig shared;
   shared.geo->set_pool(&pool, 0);  // every call to the pool
-  shared.cut();
+  cut(shared);
   ASSERT_GT(alone.geo->kernel_calls(), 10u);
   EXPECT_EQ(alone.geo->kernel_calls_shared(), 0u);
   EXPECT_EQ(shared.geo->kernel_calls(), alone.geo->kernel_calls());
@@ -74,9 +54,9 @@ TEST(LivePool, SharedCallsLeaveTheSameSolidAsOneThread) {
 
 TEST(LivePool, OnlyCallsAboveTheThresholdGoToThePool) {
   geom::ParallelSubtractor pool(2);
-  Rig rig;
+  GeometryRig rig;
   rig.geo->set_pool(&pool, 3'600'000'000'000);  // an hour: no call is predicted that long
-  rig.cut();
+  cut(rig);
   EXPECT_GT(rig.geo->kernel_calls(), 10u);
   EXPECT_EQ(rig.geo->kernel_calls_shared(), 0u);
   rig.geo->set_pool(nullptr);
