@@ -138,18 +138,27 @@ TEST(LiveRun, EmulatorWithToolChangesMatchesBatch) {
 }
 
 TEST(LiveRun, AKernelPoolOnTheGeometryThreadMatchesBatch) {
-  // [lbr] live_threads = 2: the geometry thread makes the pool when it starts and ends it
-  // when it ends; the part is the batch's (tests/app_live_pool_test.cpp: byte for byte).
+  // [lbr] live_threads = 2 with a source at real time: the geometry thread makes the pool
+  // when it starts and ends it when it ends; the part is the batch's
+  // (tests/app_live_pool_test.cpp: byte for byte). As fast as possible: no pool.
   app::Profile p = app::default_profile();
   p.live_threads = 2;
   const std::string program = std::string(kShortProgram) + "rapid 20 30 5\ntool 2\nrapid 30 60 5\nline 30 60 -2\nline 80 60 -2\nrapid 80 60 5\n";
-  const app::LiveResult r = run_emulated(p, program, "lbr_live_pool", "pool.moves");
+  const app::LiveResult fast = run_emulated(p, program, "lbr_live_pool", "pool.moves");
+  EXPECT_EQ(fast.kernel_threads, 1);
+  EXPECT_EQ(fast.kernel_calls_shared, 0u);
+  std::atomic<bool> stop{false};
+  app::LiveOptions o;
+  o.source = "emulator:" + testing::TempDir() + "/lbr_live_pool/pool.moves";
+  o.speed = 1.0;
+  const app::LiveResult r = app::run_live(p, o, stop);
   const app::BatchResult b = app::run_batch(p, nc::parse_movelist(program, "pool"));
   cpu_set_t set;
   CPU_ZERO(&set);
   ASSERT_EQ(sched_getaffinity(0, sizeof(set), &set), 0);
   EXPECT_EQ(r.kernel_threads, std::min(2, CPU_COUNT(&set)));
   EXPECT_LE(r.kernel_calls_shared, r.kernel_calls);
+  EXPECT_NEAR(fast.removed_volume_mm3, b.removed_volume_mm3, kLiveVsBatch * b.removed_volume_mm3);
   EXPECT_EQ(r.samples_lost, 0u);
   EXPECT_EQ(r.samples_applied, r.samples_received);
   EXPECT_GT(b.removed_volume_mm3, 100.0);

@@ -323,11 +323,20 @@ void rest_until(const LivePipeline::Impl& p, std::int64_t due) noexcept {
 // the saturated geometry thread at the pool's barriers: finish5x lag p99 40 ms against 5.4
 // ms, docs/performance.md "Two kernel threads live") and its processors (pinned by
 // geometry_cpu: no pool). They work only inside the calls the pool takes, so each core keeps
-// the geometry thread's duty limit. Opt-in: on two cores a busy HAL thread (an emulator at
-// --speed 200) keeps the worker off its core, and the geometry thread waits for it.
+// the geometry thread's duty limit. Opt-in, and only for sources at real time or slower.
 void start_kernel_pool(LivePipeline::Impl& p) {
   const int n = live_kernel_threads(p.profile);
   if (n < 2) return;
+  // Only for a source at the machine's pace: one faster than real time (a replay or the
+  // emulator at --speed > 1, or as fast as possible) keeps the HAL thread busy on the
+  // worker's core, the geometry thread then waits at the pool's barriers for a worker that
+  // cannot run, and the HAL thread waits for the ring: the demo at --speed 200 made 127
+  // kernel calls instead of 8 537, lag p99 6.6 s, and a SCHED_OTHER thread waited 0.9 s.
+  if (!(p.opt.speed > 0.0 && p.opt.speed <= 1.0)) {
+    spdlog::warn("live kernel: live_threads = {} needs a source at real time or slower (--speed {}); one thread", n,
+                 p.opt.speed);
+    return;
+  }
   try {
     p.pool = std::make_unique<geom::ParallelSubtractor>(n);
   } catch (const std::system_error& e) {
