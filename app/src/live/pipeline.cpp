@@ -55,6 +55,7 @@ struct LivePipeline::Impl {
   // The live kernel pool (Geometry::set_pool): made and destroyed by the geometry thread
   // (start_kernel_pool()), so that its workers take that thread's policy and processors.
   std::unique_ptr<geom::ParallelSubtractor> pool;
+  bool pool_allowed = false;                 // the source is paced at real time or slower
   std::atomic<int> kernel_threads{1};
   std::unique_ptr<Geometry> geo;
   std::unique_ptr<live::LiveChecks> checks;  // collision checks on the geometry thread (null: off)
@@ -326,17 +327,7 @@ void rest_until(const LivePipeline::Impl& p, std::int64_t due) noexcept {
 // the geometry thread's duty limit. Opt-in, and only for sources at real time or slower.
 void start_kernel_pool(LivePipeline::Impl& p) {
   const int n = live_kernel_threads(p.profile);
-  if (n < 2) return;
-  // Only for a source at the machine's pace: one faster than real time (a replay or the
-  // emulator at --speed > 1, or as fast as possible) keeps the HAL thread busy on the
-  // worker's core, the geometry thread then waits at the pool's barriers for a worker that
-  // cannot run, and the HAL thread waits for the ring: the demo at --speed 200 made 127
-  // kernel calls instead of 8 537, lag p99 6.6 s, and a SCHED_OTHER thread waited 0.9 s.
-  if (!(p.opt.speed > 0.0 && p.opt.speed <= 1.0)) {
-    spdlog::warn("live kernel: live_threads = {} needs a source at real time or slower (--speed {}); one thread", n,
-                 p.opt.speed);
-    return;
-  }
+  if (n < 2 || !p.pool_allowed) return;
   try {
     p.pool = std::make_unique<geom::ParallelSubtractor>(n);
   } catch (const std::system_error& e) {
@@ -345,6 +336,19 @@ void start_kernel_pool(LivePipeline::Impl& p) {
   }
   p.geo->set_pool(p.pool.get());
   p.kernel_threads.store(n, std::memory_order_relaxed);
+}
+
+// Before the threads start: the pool only for a source at the machine's pace. One faster
+// than real time (a replay or the emulator at --speed > 1, or as fast as possible) keeps
+// the HAL thread busy on the worker's core, the geometry thread then waits at the pool's
+// barriers for a worker that cannot run, and the HAL thread waits for the ring: the demo at
+// --speed 200 made 127 kernel calls instead of 8 537, lag p99 6.6 s, and a SCHED_OTHER
+// thread waited 0.9 s.
+void allow_kernel_pool(LivePipeline::Impl& p) {
+  p.pool_allowed = p.opt.speed > 0.0 && p.opt.speed <= 1.0;
+  if (p.profile.live_threads > 1 && !p.pool_allowed)
+    spdlog::warn("live kernel: live_threads = {} needs a source at real time or slower (--speed {}); one thread",
+                 p.profile.live_threads, p.opt.speed);
 }
 
 void stop_kernel_pool(LivePipeline::Impl& p) noexcept {
@@ -701,6 +705,7 @@ void LivePipeline::start() {
   Impl& p = *impl_;
   if (!p.geo) throw std::logic_error("LivePipeline::start() before configure()");
   p.t0 = sched::now_ns();
+  allow_kernel_pool(p);
   p.geo_running.store(true, std::memory_order_release);
   p.geometry = std::thread([&p] { geometry_thread(p); });
   p.hal = std::thread([&p] { hal_thread(p); });
