@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "geom/serialize.hpp"
 #include "test_util.hpp"
 
 using namespace lbr;
@@ -338,6 +339,45 @@ std::vector<geom::SweepRef> refs(const geom::CutterShape& c, const std::vector<g
 }
 
 }  // namespace
+
+// A plunge into the start of a joined pass and a retract from its end: on every level their
+// section is the disk of the pass's first (last) point, which the pass's outline contains,
+// so they add no section and the solid is the one the pass alone leaves, byte for byte. A
+// plunge beside a single move keeps its section.
+TEST(Joined, PlungeAndRetractBesideAPassAddNothingToIt) {
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
+  std::vector<geom::SweepRef> pass;
+  // A dip to z -4 with level ends, so that on every level above -3 the first and last moves
+  // are in the outline.
+  geom::Vec3 prev{10, 20, -3};
+  for (int i = 1; i <= 160; ++i) {
+    const double x = 10.0 + 0.25 * i;
+    const geom::Vec3 p{x, 20.0, -3.0 - 0.5 * (1.0 - std::cos(2.0 * test::kPi * (x - 10.0) / 40.0))};
+    pass.push_back({&c, {prev, {0, 0, 1}}, {p, {0, 0, 1}}, static_cast<geom::MoveId>(10 + i)});
+    prev = p;
+  }
+  std::vector<geom::SweepRef> with = pass;
+  with.insert(with.begin(), geom::SweepRef{&c, test::at(10, 20, 5), test::at(10, 20, -3), 10});
+  with.push_back({&c, {prev, {0, 0, 1}}, {{prev.x, prev.y, 5}, {0, 0, 1}}, 500});
+
+  geom::LbrSolid alone(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  geom::LbrSolid both(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const geom::SubtractStats sa = alone.subtract(pass);
+  const geom::SubtractStats sb = both.subtract(with);
+  EXPECT_EQ(sb.sections, sa.sections);
+  EXPECT_EQ(sb.sections_trimmed, sa.sections_trimmed + 2 * 30);  // both still moves, on the 30 levels above -3
+  EXPECT_EQ(geom::to_bytes(both), geom::to_bytes(alone));
+  EXPECT_GT(test::removed(alone), 100.0);
+
+  // A plunge beside one move: no outline, so its section stays.
+  geom::LbrSolid single(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const std::vector<geom::SweepRef> two{with[0], with[1]};
+  const geom::SubtractStats ss = single.subtract(two);
+  geom::LbrSolid one(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const geom::SubtractStats so = one.subtract(std::span<const geom::SweepRef>(&with[1], 1));
+  EXPECT_GT(ss.sections, so.sections);
+  EXPECT_EQ(both.check_invariants(), "");
+}
 
 TEST(TightLoop, HelixBatchEndsAfterOneTurn) {
   // Flat Ø8 on a helix of radius 2 (4 mm across: within 2 diameters), 720 chords a turn: the

@@ -96,3 +96,49 @@ TEST(RemoveSlivers, ATinyContourIsEmptied) {
   EXPECT_TRUE(remove_slivers(p, region, 1.415, tmp));
   EXPECT_TRUE(p.empty());
 }
+
+namespace {
+
+Cell cell_of(std::vector<Polygon> polys) {
+  Cell c;
+  for (Polygon& p : polys) p.bbox = bounds_of(p.outer.pts);
+  c.polys = std::move(polys);
+  detail::refresh_cell(c);
+  return c;
+}
+
+Rect material_box_all(const Cell& c, const Rect& r) {
+  std::vector<std::uint32_t> all;
+  for (std::uint32_t i = 0; i < c.polys.size(); ++i) all.push_back(i);
+  return detail::material_box(c, all, r);
+}
+
+}  // namespace
+
+// The box of the material inside a rectangle, which a clip's paths are cut to: from the
+// edges inside it and its corners in the material; nothing where the rectangle lies in a
+// hole or beyond the material.
+TEST(MaterialBox, CornersInMaterialEdgesInsideAndHoles) {
+  Polygon sq;
+  sq.outer.pts = {{0, 0}, {100, 0}, {100, 100}, {0, 100}};
+  sq.holes.push_back(Contour{{{40, 40}, {40, 60}, {60, 60}, {60, 40}}, 0});
+  const Cell c = cell_of({sq});
+  EXPECT_TRUE(material_box_all(c, Rect{45, 45, 55, 55}).empty());       // in the hole
+  EXPECT_TRUE(material_box_all(c, Rect{110, 10, 120, 20}).empty());     // beside the square
+  EXPECT_EQ(material_box_all(c, Rect{30, 30, 50, 50}), (Rect{30, 30, 50, 50}));  // a corner in the hole
+  EXPECT_EQ(material_box_all(c, Rect{90, 10, 120, 20}), (Rect{90, 10, 100, 20}));
+  EXPECT_EQ(material_box_all(c, Rect{45, 20, 55, 50}), (Rect{45, 20, 55, 40}));  // down to the hole's side
+  EXPECT_EQ(material_box_all(c, Rect{-10, -10, 200, 200}), (Rect{0, 0, 100, 100}));
+}
+
+TEST(MaterialBox, ASlantedEdgeIsCutToTheRectangle) {
+  Polygon tri;
+  tri.outer.pts = {{0, 0}, {10, 0}, {0, 10}};
+  const Cell c = cell_of({tri});
+  // x + y <= 10 within [4, 20]²: the triangle (4, 4), (6, 4), (4, 6).
+  EXPECT_EQ(material_box_all(c, Rect{4, 4, 20, 20}), (Rect{4, 4, 6, 6}));
+  // A crossing between grid points is rounded outwards: x + y <= 10 within y >= 3.5 is not
+  // representable, so use y in [3, 20], x in [5, 20]: (5, 3) .. (7, 3), (5, 5).
+  EXPECT_EQ(material_box_all(c, Rect{5, 3, 20, 20}), (Rect{5, 3, 7, 5}));
+  EXPECT_TRUE(material_box_all(c, Rect{6, 6, 20, 20}).empty());
+}

@@ -225,7 +225,7 @@ void SubtractEngine::run_difference(const Cell& cell, int region, const LevelSec
   ClipperLib::Clipper& c = ws.clipper;
   c.Clear();
   c.StrictlySimple(s_.spec_.strictly_simple);
-  const Rect clip_box = add_clip_paths(cell, region, ls, sh, ws);
+  const Rect clip_box = add_clip_paths(region, ls, sh, ws);
   const bool windowed = add_windowed_subjects(cell, clip_box, ws);
   if (!windowed) add_subjects(cell, ws);
   ws.tree.Clear();
@@ -238,7 +238,7 @@ void SubtractEngine::run_difference(const Cell& cell, int region, const LevelSec
   }
   ++stats.window_fallbacks;
   c.Clear();
-  (void)add_clip_paths(cell, region, ls, sh, ws);
+  (void)add_clip_paths(region, ls, sh, ws);
   add_subjects(cell, ws);
   ws.tree.Clear();
   c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
@@ -250,22 +250,20 @@ Rect SubtractEngine::grown_region_rect(int region) const noexcept {
   return Rect{rr.x0 - g, rr.y0 - g, rr.x1 + g, rr.y1 + g};
 }
 
-// The selected sections as clip paths, each cut down (cut_to_rect()) to the box of the
-// touched polygons grown by kKeepMarginUnits: the difference depends only on the part of a
-// section that meets the material, which lies strictly inside that box, and inside it the
-// cut changes no vertex and no winding number. A joined outline runs along a whole pass and
-// a finishing pass mostly over material already removed, so most of its edges (its caps
-// over cleared levels, the stretch beyond the material) leave the clip. A chain enters as its
-// offset's piece for the region, cut the same way. Returns the box of the paths added.
-Rect SubtractEngine::add_clip_paths(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh,
+// The selected sections as clip paths, each cut down (cut_to_rect()) to ws.keep, the box of
+// the material they may meet (material_box()) grown by kKeepMarginUnits: the difference
+// depends only on the part of a section that meets the material, which lies strictly inside
+// that box, and inside it the cut changes no vertex and no winding number. A joined outline
+// runs along a whole pass and a finishing pass mostly over material already removed, so most
+// of its edges (its caps over cleared levels, the stretch beyond the material) leave the
+// clip. A chain enters as its offset's piece for the region, cut the same way. Returns the
+// box of the paths added.
+Rect SubtractEngine::add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh,
                                     SubtractWorkspace& ws) const {
   ClipperLib::Clipper& c = ws.clipper;
-  Rect keep;
-  for (std::uint32_t p : ws.touched) keep.add(cell.polys[p].bbox);
-  keep = Rect{keep.x0 - kKeepMarginUnits, keep.y0 - kKeepMarginUnits, keep.x1 + kKeepMarginUnits, keep.y1 + kKeepMarginUnits};
+  const Rect& keep = ws.keep;
   Rect added;
-  auto add = [&](const Path& path) {
-    const Rect box = bounds_of(path);
+  auto add = [&](const Path& path, const Rect& box) {
     if (path.size() < kCutSectionVertices || contains(keep, box)) {
       if (c.AddPath(path, ClipperLib::ptClip, true)) added.add(box);
       return;
@@ -275,11 +273,9 @@ Rect SubtractEngine::add_clip_paths(const Cell& cell, int region, const LevelSec
   };
   for (std::uint32_t k : ws.selected) {
     if (ls.chain[k] != kNoChain) {
-      for (const Path& piece : offset_piece(sh, ls.chain[k], region, ws)) add(piece);
-    } else if (ls.paths[k].size() < kCutSectionVertices || contains(keep, ls.box[k])) {
-      if (c.AddPath(ls.paths[k], ClipperLib::ptClip, true)) added.add(ls.box[k]);
+      for (const Path& piece : offset_piece(sh, ls.chain[k], region, ws)) add(piece, bounds_of(piece));
     } else {
-      add(ls.paths[k]);
+      add(ls.paths[k], ls.box[k]);
     }
   }
   return added;
@@ -298,6 +294,15 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
     return false;
   }
 
+  // What the sections may cut: the touched polygons within the sections' box.
+  Rect reach;
+  for (std::uint32_t k : ws.selected) reach.add(ls.box[k]);
+  const Rect m = material_box(cell, ws.touched, reach);
+  if (m.empty()) {
+    ++stats.cells_out_of_reach;
+    return false;
+  }
+  ws.keep = Rect{m.x0 - kKeepMarginUnits, m.y0 - kKeepMarginUnits, m.x1 + kKeepMarginUnits, m.y1 + kKeepMarginUnits};
   run_difference(cell, region, ls, sh, ws, stats);
   ++stats.cells_clipped;
   ws.fresh.clear();

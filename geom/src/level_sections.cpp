@@ -129,6 +129,60 @@ void SubtractEngine::add_lathe_sections(double zc, const SubtractShared& sh, Lev
   }
 }
 
+namespace {
+
+// The run's angle grid for joined outlines: the tool's full radius sets it. Even, so that a
+// stadium's caps are exact half turns (chain_outline.cpp, notch_is_exact()).
+int outline_grid(const Sweep& sw) noexcept {
+  return (Sweep::circle_segments(sw.shape().radius(), sw.shape().chord_tol_mm) + 1) / 2 * 2;
+}
+
+// Moves si, si + 1, ... (before `end`) whose sections on zc share their joint disks, with
+// their caps in ws.caps; how many (an outline needs two or more).
+std::size_t joinable_moves(double zc, std::uint32_t si, std::uint32_t end, int grid, const SubtractShared& sh,
+                           SubtractWorkspace& ws) {
+  if (ws.caps.size() < end - si) ws.caps.resize(end - si);
+  std::size_t count = 0;
+  while (si + count < end && sh.sweeps[si + count].section_caps(zc, grid, ws.scratch, ws.caps[count]) &&
+         (count == 0 || (ws.caps[count - 1].c1.x == ws.caps[count].c0.x && ws.caps[count - 1].c1.y == ws.caps[count].c0.y &&
+                         ws.caps[count - 1].rho1 == ws.caps[count].rho0)))
+    ++count;
+  return count;
+}
+
+// A still move (a plunge or a retract: the tip moves along the vertical axis only) beside a
+// joined outline on the outline's grid: a plunge's lowest point is where the outline's first
+// move starts, a retract's where its last move ended. A tool is no narrower above than below,
+// so the still move's section on zc is the disk of its lowest point, no wider than the
+// outline's cap there (radius `rho` on the grid, centre c); discretised on the outline's grid
+// it is a concentric copy of that cap's polygon, no larger, which the outline contains
+// (docs/lbr-conventions.md, "Joined sections"). True when that holds: the section adds
+// nothing to the outline and is left out.
+bool still_inside_cap(double zc, const Sweep& sw, SectionScratch::P2 c, double rho, int grid, SectionScratch& sc) {
+  const Vec3& low = sw.from().tip.z <= sw.to().tip.z ? sw.from().tip : sw.to().tip;
+  if (c.x != low.x || c.y != low.y) return false;
+  const double r = sw.widest_disk_mm(zc, sc);
+  return r > 0.0 && r * Sweep::circle_grow_width(grid) <= rho;
+}
+
+bool still_move(const Sweep& sw) noexcept {
+  return sw.vertical() && sw.from().tip.x == sw.to().tip.x && sw.from().tip.y == sw.to().tip.y;
+}
+
+// A still move at si whose section on zc lies inside the outline that ends just before it
+// (after_outline: that outline's end cap, radius and grid) or the one that starts just after it.
+bool still_beside_outline(double zc, std::uint32_t si, std::uint32_t end, bool after_outline, SectionScratch::P2 cap,
+                          double rho, int grid, const SubtractShared& sh, SubtractWorkspace& ws) {
+  const Sweep& sw = sh.sweeps[si];
+  if (sw.to().tip.z > sw.from().tip.z) return after_outline && still_inside_cap(zc, sw, cap, rho, grid, ws.scratch);
+  if (si + 2 >= end) return false;  // no two moves after it
+  const int g = outline_grid(sh.sweeps[si + 1]);
+  if (joinable_moves(zc, si + 1, std::min(end, si + 3), g, sh, ws) < 2) return false;
+  return still_inside_cap(zc, sw, ws.caps[0].c0, ws.caps[0].rho0, g, ws.scratch);
+}
+
+}  // namespace
+
 // The sections of one run of sweeps on plane zc: consecutive moves whose sections share
 // their joint disk become one outline (chain_outline.hpp); the others are emitted one by
 // one, trimmed where the previous vertical section covers them (trim_covered()).
@@ -136,6 +190,11 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
                                         const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                                         SubtractStats& stats) const {
   Capsule prev_core;  // inside the last single vertical section of this run (trim_covered())
+  // The last joined outline on this level: one past its last move, and that move's end cap.
+  std::uint32_t outline_end = run.second;
+  SectionScratch::P2 end_cap{};
+  double end_rho = 0.0;
+  int end_grid = 0;
   const double band = reach_band_units(s_.spec_.chord_tol_mm);
   auto push_boxes = [&](std::size_t before, MoveId id) {
     for (std::size_t k = before; k < ls.paths.size(); ++k) {
@@ -165,15 +224,8 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
     flush_tilted();
     // Joined outline from si, when si and at least the next move share their joint disk.
     if (run.second - si >= 2) {
-      // One angle grid along the run: the tool's full radius sets it. Even, so that a
-      // stadium's caps are exact half turns (chain_outline.cpp, notch_is_exact()).
-      const int grid = (Sweep::circle_segments(sw.shape().radius(), sw.shape().chord_tol_mm) + 1) / 2 * 2;
-      if (ws.caps.size() < run.second - si) ws.caps.resize(run.second - si);
-      std::size_t count = 0;
-      while (si + count < run.second && sh.sweeps[si + count].section_caps(zc, grid, ws.scratch, ws.caps[count]) &&
-             (count == 0 || (ws.caps[count - 1].c1.x == ws.caps[count].c0.x && ws.caps[count - 1].c1.y == ws.caps[count].c0.y &&
-                             ws.caps[count - 1].rho1 == ws.caps[count].rho0)))
-        ++count;
+      const int grid = outline_grid(sw);
+      const std::size_t count = joinable_moves(zc, si, run.second, grid, sh, ws);
       if (count >= 2) {
         const std::size_t before = ls.paths.size();
         bool star = false;
@@ -187,12 +239,21 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
           begin_reach(ls, before);
           add_outline_reach(std::span<const MoveCaps>(ws.caps.data(), count), band, ls.reach);
           ls.reach_end[before] = static_cast<std::uint32_t>(ls.reach.size());
+          outline_end = si + static_cast<std::uint32_t>(count);
+          end_cap = ws.caps[count - 1].c1;
+          end_rho = ws.caps[count - 1].rho1;
+          end_grid = grid;
         }
         stats.sections_joined += count;
         prev_core = Capsule{};
         si += static_cast<std::uint32_t>(count);
         continue;
       }
+    }
+    if (still_move(sw) && still_beside_outline(zc, si, run.second, outline_end == si, end_cap, end_rho, end_grid, sh, ws)) {
+      ++stats.sections_trimmed;
+      ++si;
+      continue;
     }
     const std::size_t before = ls.paths.size();
     sw.section(zc, ls.paths, ws.scratch);

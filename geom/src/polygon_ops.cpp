@@ -90,6 +90,68 @@ double perimeter(const Path& p) noexcept {
   return l;
 }
 
+namespace {
+
+// Adds to `box` the part of the edge p -> q inside r (Liang-Barsky), rounded outwards.
+void add_edge_in(const Point& p, const Point& q, const Rect& r, Rect& box) noexcept {
+  if (std::max(p.X, q.X) < r.x0 || std::min(p.X, q.X) > r.x1 || std::max(p.Y, q.Y) < r.y0 || std::min(p.Y, q.Y) > r.y1)
+    return;
+  const bool p_in = p.X >= r.x0 && p.X <= r.x1 && p.Y >= r.y0 && p.Y <= r.y1;
+  const bool q_in = q.X >= r.x0 && q.X <= r.x1 && q.Y >= r.y0 && q.Y <= r.y1;
+  if (p_in && q_in) {
+    box.add(p);
+    box.add(q);
+    return;
+  }
+  const double dx = static_cast<double>(q.X - p.X), dy = static_cast<double>(q.Y - p.Y);
+  double t0 = 0.0, t1 = 1.0;
+  auto side = [&](double den, double num) {  // keeps den * t <= num
+    if (den == 0.0) return num >= 0.0;
+    const double t = num / den;
+    if (den > 0.0) t1 = std::min(t1, t);
+    else t0 = std::max(t0, t);
+    return t0 <= t1;
+  };
+  const double px = static_cast<double>(p.X), py = static_cast<double>(p.Y);
+  if (!side(-dx, px - static_cast<double>(r.x0)) || !side(dx, static_cast<double>(r.x1) - px) ||
+      !side(-dy, py - static_cast<double>(r.y0)) || !side(dy, static_cast<double>(r.y1) - py))
+    return;
+  for (const double t : {t0, t1}) {
+    const double x = px + t * dx, y = py + t * dy;
+    box.add(Point{std::max(r.x0, static_cast<Coord>(std::floor(x))), std::max(r.y0, static_cast<Coord>(std::floor(y)))});
+    box.add(Point{std::min(r.x1, static_cast<Coord>(std::ceil(x))), std::min(r.y1, static_cast<Coord>(std::ceil(y)))});
+  }
+}
+
+void add_contour_in(const Path& c, const Rect& r, Rect& box) noexcept {
+  for (std::size_t i = 0, j = c.size() - 1; i < c.size(); j = i++) add_edge_in(c[j], c[i], r, box);
+}
+
+}  // namespace
+
+Rect material_box(const Cell& cell, std::span<const std::uint32_t> touched, const Rect& r) noexcept {
+  Rect box;
+  if (r.empty()) return box;
+  const Point corners[4] = {{r.x0, r.y0}, {r.x1, r.y0}, {r.x1, r.y1}, {r.x0, r.y1}};
+  bool in[4] = {false, false, false, false};
+  for (std::uint32_t t : touched) {
+    const Polygon& poly = cell.polys[t];
+    if (!poly.bbox.intersects(r)) continue;
+    add_contour_in(poly.outer.pts, r, box);
+    for (const Contour& h : poly.holes) add_contour_in(h.pts, r, box);
+    for (int k = 0; k < 4; ++k) {
+      const Point& c = corners[k];
+      if (in[k] || c.X < poly.bbox.x0 || c.X > poly.bbox.x1 || c.Y < poly.bbox.y0 || c.Y > poly.bbox.y1) continue;
+      if (ClipperLib::PointInPolygon(c, poly.outer.pts) == 0) continue;
+      in[k] = std::none_of(poly.holes.begin(), poly.holes.end(),
+                           [&](const Contour& h) { return ClipperLib::PointInPolygon(c, h.pts) == 1; });
+    }
+  }
+  for (int k = 0; k < 4; ++k)
+    if (in[k]) box.add(corners[k]);
+  return box;
+}
+
 void refresh_cell(Cell& cell) noexcept {
   cell.bbox = Rect{};
   cell.area_units2 = 0.0;

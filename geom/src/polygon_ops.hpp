@@ -45,6 +45,13 @@ void split_at_lines(Path& path, std::span<const Coord> xs, std::span<const Coord
 // `tmp` is a scratch buffer.
 bool remove_slivers(Path& contour, const Rect& keep, double dist, Path& tmp);
 
+// A box that holds every point of the polygons `touched` of `cell` lying in r: the parts
+// of their edges inside r (crossings with r's sides rounded outwards) and the corners of r
+// that lie in the polygons or on them. The box of S ∩ r is that of its boundary, which
+// consists of pieces of S's edges inside r and pieces of r's sides inside S, and the ends
+// of the latter are corners of r or crossings. Empty when the polygons do not meet r.
+[[nodiscard]] Rect material_box(const Cell& cell, std::span<const std::uint32_t> touched, const Rect& r) noexcept;
+
 // b lies wholly inside a.
 [[nodiscard]] inline bool contains(const Rect& a, const Rect& b) noexcept {
   return b.x0 >= a.x0 && b.x1 <= a.x1 && b.y0 >= a.y0 && b.y1 <= a.y1;

@@ -74,7 +74,7 @@ class SubtractEngine {
                  SubtractStats& stats);                                                                    // D
 
   // --- cell_clip.cpp ---
-  Rect add_clip_paths(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const;
+  Rect add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const;
   void run_difference(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                       SubtractStats& stats) const;
   bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,

@@ -133,6 +133,7 @@ struct SubtractWorkspace {
   std::vector<Polygon> fresh, kept;
   ReachScratch reach;               // material_out_of_reach()
   WindowScratch window;             // windowed clips (window_clip.hpp)
+  Rect keep;                        // a clip's paths are cut to this box (the material they may meet)
 };
 
 }  // namespace lbr::geom::detail

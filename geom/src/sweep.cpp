@@ -635,6 +635,13 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
   }
 }
 
+double Sweep::widest_disk_mm(double zc, SectionScratch& sc) const {
+  if (!vertical_ || zc < box_.lo.z || zc > box_.hi.z || !section_disks(zc, sc)) return 0.0;
+  double r = 0.0;
+  for (const auto& d : sc.disks) r = std::max(r, d.r);
+  return r;
+}
+
 bool Sweep::section_caps(double zc, int n, SectionScratch& sc, MoveCaps& out) const {
   if (!vertical_ || zc < box_.lo.z || zc > box_.hi.z) return false;
   const double dx = to_.tip.x - from_.tip.x, dy = to_.tip.y - from_.tip.y;

@@ -168,6 +168,10 @@ class Sweep {
   // the buffers have grown.
   bool section_caps(double z_mm, int n, SectionScratch& scratch, MoveCaps& out) const;
 
+  // Vertical sweeps only: the radius of the widest disk of the section on z = z_mm, 0 when the
+  // plane misses the cutting part [mm]. Real-time safe once the buffers have grown.
+  [[nodiscard]] double widest_disk_mm(double z_mm, SectionScratch& scratch) const;
+
   // Tilted sweeps only: appends to `out` one TiltedPiece per sub-step whose hull meets plane
   // z = z_mm and, when `material` is given, does not lie beside it (as section()); returns
   // how many. Real-time safe once `out` has grown.
