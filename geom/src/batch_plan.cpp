@@ -222,7 +222,6 @@ void SubtractEngine::prepare(std::span<const SweepRef> batch, SubtractShared& sh
   sh.border_y = std::span<const Coord>(s_.ys_).subspan(1, s_.ys_.size() - 2);
   for (auto& next : sh.next) next.store(0, std::memory_order_relaxed);
   sh.ahead_ready.store(0, std::memory_order_relaxed);
-  sh.offsets_ready = false;
 }
 
 // The distinct (chain, radius) pairs of the batch, in level order: a flat tool's chain has
@@ -275,6 +274,7 @@ void SubtractEngine::size_storage(SubtractShared& sh) const {
     const std::size_t pieces = static_cast<std::size_t>((off.ix1 - off.ix0 + 1) * (off.iy1 - off.iy0 + 1));
     off.cut.resize(pieces);
     off.state.assign(pieces, 0);
+    off.built = 0;
   }
 }
 

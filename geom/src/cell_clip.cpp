@@ -225,7 +225,7 @@ void SubtractEngine::run_difference(const Cell& cell, int region, const LevelSec
   ClipperLib::Clipper& c = ws.clipper;
   c.Clear();
   c.StrictlySimple(s_.spec_.strictly_simple);
-  const Rect clip_box = add_clip_paths(region, ls, sh, ws);
+  const Rect clip_box = add_clip_paths(region, ls, sh, ws, stats);
   const bool windowed = add_windowed_subjects(cell, clip_box, ws);
   if (!windowed) add_subjects(cell, ws);
   ws.tree.Clear();
@@ -238,7 +238,7 @@ void SubtractEngine::run_difference(const Cell& cell, int region, const LevelSec
   }
   ++stats.window_fallbacks;
   c.Clear();
-  (void)add_clip_paths(region, ls, sh, ws);
+  (void)add_clip_paths(region, ls, sh, ws, stats);
   add_subjects(cell, ws);
   ws.tree.Clear();
   c.Execute(ClipperLib::ctDifference, ws.tree, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
@@ -258,8 +258,8 @@ Rect SubtractEngine::grown_region_rect(int region) const noexcept {
 // of its edges (its caps over cleared levels, the stretch beyond the material) leave the
 // clip. A chain enters as its offset's piece for the region, cut the same way. Returns the
 // box of the paths added.
-Rect SubtractEngine::add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh,
-                                    SubtractWorkspace& ws) const {
+Rect SubtractEngine::add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
+                                    SubtractStats& stats) const {
   ClipperLib::Clipper& c = ws.clipper;
   const Rect& keep = ws.keep;
   Rect added;
@@ -273,7 +273,7 @@ Rect SubtractEngine::add_clip_paths(int region, const LevelSections& ls, Subtrac
   };
   for (std::uint32_t k : ws.selected) {
     if (ls.chain[k] != kNoChain) {
-      for (const Path& piece : offset_piece(sh, ls.chain[k], region, ws)) add(piece, bounds_of(piece));
+      for (const Path& piece : offset_piece(sh, ls.chain[k], region, ws, stats)) add(piece, bounds_of(piece));
     } else {
       add(ls.paths[k], ls.box[k]);
     }

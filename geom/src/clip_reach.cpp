@@ -288,6 +288,13 @@ void add_outline_reach(std::span<const MoveCaps> moves, double band_units, std::
   }
 }
 
+void add_chain_reach(const Path& pts, double r_mm, std::vector<ReachCapsule>& out) {
+  const double r = r_mm * kUnitsPerMm + 2.0;
+  auto at = [&](std::size_t i) { return V2{static_cast<double>(pts[i].X), static_cast<double>(pts[i].Y)}; };
+  if (pts.size() == 1) out.push_back(ReachCapsule{at(0).x, at(0).y, at(0).x, at(0).y, r});
+  for (std::size_t i = 1; i < pts.size(); ++i) out.push_back(ReachCapsule{at(i - 1).x, at(i - 1).y, at(i).x, at(i).y, r});
+}
+
 void add_section_reach(const Path& p, double ax_mm, double ay_mm, double bx_mm, double by_mm, double band_units,
                        std::vector<ReachCapsule>& out) {
   const double k = kUnitsPerMm;

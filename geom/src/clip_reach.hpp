@@ -73,6 +73,12 @@ struct ReachScratch {
 // vertices), plus one unit for rounding, less `band_units`.
 void add_outline_reach(std::span<const MoveCaps> moves, double band_units, std::vector<ReachCapsule>& out);
 
+// Appends one capsule per segment of a chain's path `pts` [units] offset by r_mm: Clipper's
+// offset lies within r of the path but for the rounding of its vertices to units, so the
+// capsules have radius r plus two units and no band (an offset's straight walls are exact:
+// a band would leave slivers along them).
+void add_chain_reach(const Path& pts, double r_mm, std::vector<ReachCapsule>& out);
+
 // Appends the capsule of a single vertical section `p` of the move from (ax, ay) to
 // (bx, by) [mm]: the largest distance of its vertices from that segment, less `band_units`.
 void add_section_reach(const Path& p, double ax_mm, double ay_mm, double bx_mm, double by_mm, double band_units,
@@ -80,7 +86,7 @@ void add_section_reach(const Path& p, double ax_mm, double ay_mm, double bx_mm, 
 
 // True when no material of `cell` (its polygons `touched`) lies within any capsule of the
 // sections `selected` of `ls`: their clip can remove at most the band. False when a selected
-// section has no capsules (chain offsets, tilted and lathe sections). Exact up to the
+// section has no capsules (tilted and lathe sections). Exact up to the
 // rounding of doubles: every material edge against the capsules that an angular bound about
 // the capsules' mean point cannot exclude, and one point of each connected chain of
 // capsules against the material. No allocation once `rs` has grown.

@@ -23,14 +23,22 @@ constexpr std::size_t kTiltedGroup = 8;
 // a slot's walls: no bias, where vertices on r·θ/sin θ put them up to tol/2 outside).
 // Clipper puts the round joins' and ends' vertices on r (inscribed); its arc tolerance tol/2
 // keeps them within tol/2 inside the exact arcs (docs/lbr-conventions.md, "Straight walls").
+// Once: the first caller builds it, a caller meanwhile waits for it.
 void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
-  ++stats.chain_offsets;
-  const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
   SubtractShared::Offset& off = sh.offsets[o];
-  ClipperLib::ClipperOffset co(2.0, 0.5 * c.shape->chord_tol_mm * kUnitsPerMm);
-  co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
-  off.paths.clear();
-  co.Execute(off.paths, sh.offset_keys[o].r * kUnitsPerMm);
+  std::atomic_ref<std::uint8_t> state(off.built);
+  std::uint8_t s = state.load(std::memory_order_acquire);
+  if (s == 0 && state.compare_exchange_strong(s, 1, std::memory_order_acq_rel)) {
+    ++stats.chain_offsets;
+    const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
+    ClipperLib::ClipperOffset co(2.0, 0.5 * c.shape->chord_tol_mm * kUnitsPerMm);
+    co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
+    off.paths.clear();
+    co.Execute(off.paths, sh.offset_keys[o].r * kUnitsPerMm);
+    state.store(2, std::memory_order_release);
+    return;
+  }
+  while (state.load(std::memory_order_acquire) != 2) cpu_relax();
 }
 
 namespace {
@@ -81,12 +89,18 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
 }
 
 // Chains: one entry for the whole offset (outer contours and holes); a clip adds its piece
-// cut to the region (SubtractShared::Offset).
+// cut to the region (SubtractShared::Offset), and builds the offset first if no clip has.
+// The offset lies within the capsules of radius r about the chain's segments, so a cell
+// whose material is out of their reach builds nothing (docs/lbr-conventions.md, "Clips out
+// of reach").
 void SubtractEngine::add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls) {
   for (std::size_t ci = 0; ci < sh.chain_count; ++ci) {
     const std::uint32_t o = sh.offset_of[static_cast<std::size_t>(level - sh.lb) * sh.chain_count + ci];
-    if (o == kNoChain) continue;  // (the offset itself may still be in the making)
+    if (o == kNoChain) continue;
     ls.chain_offset[ci] = o;
+    begin_reach(ls, ls.paths.size());
+    add_chain_reach(sh.chains[ci].pts, sh.offset_keys[o].r, ls.reach);
+    ls.reach_end.back() = static_cast<std::uint32_t>(ls.reach.size());
     ls.paths.emplace_back();
     ls.box.push_back(sh.offsets[o].box);
     ls.id.push_back(sh.chains[ci].id);
@@ -369,13 +383,15 @@ void SubtractEngine::trim_tilted(std::uint32_t si, std::size_t before, const Sub
 
 // The chain offset `o` cut to `region` (grown by 1 mm); the first thread that needs a piece
 // cuts it, one that needs it meanwhile waits (a cut takes microseconds).
-const Paths& SubtractEngine::offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const {
+const Paths& SubtractEngine::offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws,
+                                          SubtractStats& stats) const {
   static const Paths kNone;
   SubtractShared::Offset& off = sh.offsets[o];
   const int ix = region % s_.spec_.regions_x, iy = region / s_.spec_.regions_x;
   // A cell can touch the box on its edge from the region beside the box's first one: the
   // offset covers none of its area there.
   if (ix < off.ix0 || ix > off.ix1 || iy < off.iy0 || iy > off.iy1) return kNone;
+  build_offset(sh, o, stats);
   const Rect rr = grown_region_rect(region);
   if (contains(rr, off.box)) return off.paths;  // wholly inside: nothing to cut
   const std::size_t i = static_cast<std::size_t>((iy - off.iy0) * (off.ix1 - off.ix0 + 1) + (ix - off.ix0));

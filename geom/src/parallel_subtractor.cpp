@@ -206,7 +206,6 @@ SubtractStats ParallelSubtractor::Impl::run(LbrSolid& solid, const BatchSource& 
     total += s;
     if (done) done(s);
     if (!ahead_more_) break;
-    shared_[1 - cur_].offsets_ready = true;  // built among this batch's clips
     cur_ = 1 - cur_;
   }
   source_ = nullptr;

@@ -33,10 +33,10 @@ class SubtractEngine {
   // Called by `count` threads together, each with its own workspace, its index in
   // [0, count) and the same prepared `sh`; `sync` is a barrier over the `count` callers
   // (called twice, or never when the batch reaches no level). Each returns its share of the
-  // statistics. Phases: (A) the chain offsets and the levels' sections are built, and each
-  // cell compared with the one below; (B) each thread derives which cells start a run of
-  // equal levels; (C) those are clipped (longest first; offsets are cut to a region when a
-  // clip first needs it); (D) the rest of each run copies its result (vertical coherence).
+  // statistics. Phases: (A) the levels' sections are built, and each cell compared with the
+  // one below; (B) each thread derives which cells start a run of equal levels; (C) those
+  // are clipped (longest first; a chain offset is built, and cut to a region, when a clip
+  // first needs it); (D) the rest of each run copies its result (vertical coherence).
   // Work inside a phase is taken from shared counters. The result does not depend on
   // `count`. `ahead`, when given, is the next batch (SubtractAhead): it is prepared and its
   // chain offsets built among this batch's clips. Allocates (Clipper); does not throw.
@@ -62,10 +62,11 @@ class SubtractEngine {
                    LevelSections& ls, SubtractStats& stats) const;
   static void add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls);
   void add_lathe_sections(double zc, const SubtractShared& sh, LevelSections& ls) const;
-  const Paths& offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws) const;
+  const Paths& offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws,
+                            SubtractStats& stats) const;
 
   // --- subtract_phases.cpp ---
-  void build_offsets_and_levels(SubtractShared& sh, SubtractWorkspace& ws, SubtractStats& stats) const;  // A
+  void build_levels(SubtractShared& sh, SubtractWorkspace& ws, SubtractStats& stats) const;  // A
   void compare_cells(int level, bool below, LevelSections& ls) const;                                     // A
   void plan_clips(const SubtractShared& sh, SubtractWorkspace& ws) const;                                 // B
   void order_clips(const SubtractShared& sh, SubtractWorkspace& ws) const;                                // B
@@ -74,7 +75,8 @@ class SubtractEngine {
                  SubtractStats& stats);                                                                    // D
 
   // --- cell_clip.cpp ---
-  Rect add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws) const;
+  Rect add_clip_paths(int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
+                      SubtractStats& stats) const;
   void run_difference(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                       SubtractStats& stats) const;
   bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
@@ -94,7 +96,8 @@ class SubtractEngine {
 // included (geom::pose_deviation_mm). Allocates only when `out` grows.
 void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out);
 
-// Builds offset `o` of the prepared batch (sh.offsets[o].paths). Allocates (Clipper).
+// Builds offset `o` of the prepared batch (sh.offsets[o].paths) unless it is built; waits
+// while another thread builds it. Allocates (Clipper).
 void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats);
 
 // Index of the interval [b[i], b[i+1]] holding v, clamped to [0, b.size()-2].

@@ -56,8 +56,8 @@ SubtractStats SubtractEngine::run(SubtractShared& sh, SubtractWorkspace& ws, int
     clip_phase(sh, ws, ahead, stats);
     return stats;
   }
-  build_offsets_and_levels(sh, ws, stats);
-  sync();  // (1) offsets and sections built
+  build_levels(sh, ws, stats);
+  sync();  // (1) sections built
   plan_clips(sh, ws);
   if (count > 1) order_clips(sh, ws);
   clip_phase(sh, ws, ahead, stats);
@@ -66,18 +66,13 @@ SubtractStats SubtractEngine::run(SubtractShared& sh, SubtractWorkspace& ws, int
   return stats;
 }
 
-// Phase A: the chain offsets unless built ahead (items [0, noff)) and the levels' sections
-// (the rest); for the cells a level reaches, whether the cell starts equal to the one below
-// (read only: nothing changes before phase C).
-void SubtractEngine::build_offsets_and_levels(SubtractShared& sh, SubtractWorkspace& ws, SubtractStats& stats) const {
-  const std::size_t noff = sh.offsets_ready ? 0 : sh.offset_keys.size();
+// Phase A: the levels' sections; for the cells a level reaches, whether the cell starts
+// equal to the one below (read only: nothing changes before phase C). The chain offsets are
+// built where a clip first needs one (offset_piece()), or ahead by idle threads.
+void SubtractEngine::build_levels(SubtractShared& sh, SubtractWorkspace& ws, SubtractStats& stats) const {
   const auto n = static_cast<std::size_t>(sh.le - sh.lb);
-  for (std::size_t item = take(sh, 0); item < noff + n; item = take(sh, 0)) {
-    if (item < noff) {
-      build_offset(sh, item, stats);
-      continue;
-    }
-    const int l = sh.lb + static_cast<int>(item - noff);
+  for (std::size_t item = take(sh, 0); item < n; item = take(sh, 0)) {
+    const int l = sh.lb + static_cast<int>(item);
     LevelSections& ls = sh.levels[static_cast<std::size_t>(l - sh.lb)];
     build_level(l, sh, ws, ls, stats);
     compare_cells(l, l > sh.lb, ls);

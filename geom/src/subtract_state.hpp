@@ -76,7 +76,6 @@ struct SubtractShared {
   std::vector<OffsetKey> offset_keys;      // the batch's distinct (chain, radius), in order
   std::vector<std::uint32_t> offset_of;    // per (level - lb, chain): index into offset_keys, or ~0
   int lb = 0, le = 0;                      // the levels the batch reaches: [lb, le)
-  bool offsets_ready = false;              // the offsets' paths are built (during the batch before)
   // The regions' inner borders (the solid's xs_/ys_ without the first and last): sections
   // and offsets get a vertex where they cross one (split_at_lines()).
   std::span<const Coord> border_x, border_y;
@@ -93,6 +92,7 @@ struct SubtractShared {
     int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;
     std::vector<Paths> cut;            // (iy - iy0) * (ix1 - ix0 + 1) + (ix - ix0)
     std::vector<std::uint8_t> state;   // per piece: 0 not cut, 1 being cut, 2 cut (atomic_ref)
+    std::uint8_t built = 0;            // `paths`: 0 not built, 1 being built, 2 built (atomic_ref)
   };
   std::vector<Offset> offsets;
   std::atomic<std::size_t> next[3] = {};  // work counters: phase A, phase C, next batch's offsets
@@ -102,7 +102,8 @@ struct SubtractShared {
 // The batch after the current one, prepared during the current one's clips by one thread
 // (`prepare`: SubtractEngine::prepare() into `shared`, and whatever the caller keeps with
 // it); its chain offsets, which depend on the batch only, are then built by the threads
-// between their clips. The caller sets shared->offsets_ready once run() has returned.
+// between their clips (an offset no clip of the current batch needed waits for its first use
+// in the next one, or is never built).
 struct SubtractAhead {
   SubtractShared* shared = nullptr;
   std::function<void()> prepare;
