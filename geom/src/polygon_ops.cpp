@@ -360,10 +360,27 @@ bool remove_slivers(Path& contour, const Rect& keep, double dist, Path& tmp) {
 }
 
 void cut_to_rect(const Path& in, const Rect& r, Path& out, Path& tmp) {
-  clip_pass(in, tmp, [&](const Point& p) { return p.X > r.x0; }, [&](const Point& p) { return Point{r.x0, p.Y}; });
-  clip_pass(tmp, out, [&](const Point& p) { return p.X < r.x1; }, [&](const Point& p) { return Point{r.x1, p.Y}; });
-  clip_pass(out, tmp, [&](const Point& p) { return p.Y > r.y0; }, [&](const Point& p) { return Point{p.X, r.y0}; });
-  clip_pass(tmp, out, [&](const Point& p) { return p.Y < r.y1; }, [&](const Point& p) { return Point{p.X, r.y1}; });
+  // Only the sides the path reaches (a pass against a side wholly beyond the path copies it;
+  // projections keep the other coordinate, so a later side's test still holds).
+  const Rect b = bounds_of(in);
+  const bool left = b.x0 <= r.x0, right = b.x1 >= r.x1, below = b.y0 <= r.y0, above = b.y1 >= r.y1;
+  const int passes = int{left} + int{right} + int{below} + int{above};
+  if (passes == 0) {
+    out = in;
+    return;
+  }
+  // Alternate the buffers so that the last pass writes `out`.
+  const Path* src = &in;
+  Path* dst = passes % 2 == 1 ? &out : &tmp;
+  auto pass = [&](auto inside, auto project) {
+    clip_pass(*src, *dst, inside, project);
+    src = dst;
+    dst = dst == &out ? &tmp : &out;
+  };
+  if (left) pass([&](const Point& p) { return p.X > r.x0; }, [&](const Point& p) { return Point{r.x0, p.Y}; });
+  if (right) pass([&](const Point& p) { return p.X < r.x1; }, [&](const Point& p) { return Point{r.x1, p.Y}; });
+  if (below) pass([&](const Point& p) { return p.Y > r.y0; }, [&](const Point& p) { return Point{p.X, r.y0}; });
+  if (above) pass([&](const Point& p) { return p.Y < r.y1; }, [&](const Point& p) { return Point{p.X, r.y1}; });
 }
 
 }  // namespace detail
