@@ -76,10 +76,13 @@ void expect_animation_matches_batch(const StreamCase& run, double chord_rel) {
   ASSERT_GT(sampled, 0.0);
   // Same sweeps, other batches: the kernel merges collinear sweeps within a batch, so other
   // batch boundaries round the sections differently (measured 4.9e-6 relative on mill5,
-  // 3.8e-6 on the demo with exact stop; with the blending planner the demo's stream differs
-  // by up to 2.5e-5 between batchings (1.2 mm3 of 46 747), within the 0.001 mm merge
-  // tolerance times the cut surface; live vs replay agree to ~1e-5 for the same reason).
-  EXPECT_NEAR(animated, sampled, 5e-5 * sampled) << "animated " << animated << " mm3, batch --sampled " << sampled;
+  // 3.8e-6 on the demo with exact stop; with the blending planner the demo's stream differed
+  // by up to 2.5e-5 between batchings at the 1 µm chord tolerance, within the merge tolerance
+  // (half the chord tolerance) times the cut surface; live vs replay agree to ~1e-5 for the
+  // same reason). At the 10 µm default the merge tolerance is 5 µm: the demo measured
+  // -1.9e-5 to -8.7e-5 (105-110 batches, up to 4 mm3 of 46 734) with the machine loaded, and
+  // its bound is 2e-4 (9 mm3). One batch lost (about 1 % of the removal) moves it 50x more.
+  EXPECT_NEAR(animated, sampled, 2e-4 * sampled) << "animated " << animated << " mm3, batch --sampled " << sampled;
   EXPECT_NEAR(animated, plain, chord_rel * plain) << "animated " << animated << " mm3, batch " << plain;
 }
 
