@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "geom/serialize.hpp"
 #include "test_util.hpp"
 
 using namespace lbr;
@@ -73,5 +74,39 @@ TEST(Reach, MaterialBeyondTheBandIsStillCut) {
   const double perimeter = 2.0 * test::kPi * (10.0 + 2.0);
   EXPECT_NEAR(test::removed(s) - first, ring, 2.0 * perimeter * kTol * 5.0);
   EXPECT_GT(st.cells_changed, 0u);
+  EXPECT_EQ(s.check_invariants(), "");
+}
+
+// Chains (horizontal moves at one height, cut as the path offset by r) carry capsules of
+// radius r plus two units and no band: the same loop again with a smaller tool, whose
+// offset stays inside what the first one cleared, builds no offset and clips nothing, and
+// leaves the solid byte for byte; with a larger tool it cuts the ring between them.
+TEST(Reach, AChainInsideClearedMaterialBuildsNoOffset) {
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {60, 40, 0}, 0.1));
+  const auto d10 = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
+  const auto d8 = geom::CutterShape::build(test::tool(ToolKind::Flat, 8), kTol);
+  const auto d11 = geom::CutterShape::build(test::tool(ToolKind::Flat, 11), kTol);
+  std::vector<geom::Vec3> loop;  // a 20 x 20 square about (30, 20) at z -3, 2.5 mm moves
+  for (int k = 0; k < 8; ++k) loop.push_back({20 + 2.5 * k, 10, -3});
+  for (int k = 0; k < 8; ++k) loop.push_back({40, 10 + 2.5 * k, -3});
+  for (int k = 0; k < 8; ++k) loop.push_back({40 - 2.5 * k, 30, -3});
+  for (int k = 0; k <= 8; ++k) loop.push_back({20, 30 - 2.5 * k, -3});
+  const geom::SubtractStats first = cut(s, d10, loop, 1000);
+  EXPECT_GT(first.chain_offsets, 0u);
+  EXPECT_GT(first.cells_changed, 0u);
+  const auto before = geom::to_bytes(s);
+  const double removed = test::removed(s);
+  const geom::SubtractStats inside = cut(s, d8, loop, 1000);
+  EXPECT_EQ(inside.chain_offsets, 0u);
+  EXPECT_EQ(inside.cells_clipped, 0u);
+  EXPECT_GT(inside.cells_out_of_reach, 0u);
+  EXPECT_EQ(geom::to_bytes(s), before);
+  const geom::SubtractStats wider = cut(s, d11, loop, 1000);
+  EXPECT_GT(wider.chain_offsets, 0u);
+  // The ring between the offsets by 5 and 5.5, 3 mm deep: outside, the square's sides
+  // (4 · 20 · 0.5) and the corners' quarter rings; inside, the hole shrinks from 10 x 10 to
+  // 9 x 9 (sharp corners).
+  const double ring = 4 * 20.0 * 0.5 + test::kPi * (5.5 * 5.5 - 5.0 * 5.0) + (100.0 - 81.0);
+  EXPECT_NEAR(test::removed(s) - removed, ring * 3.0, 0.01 * ring * 3.0);
   EXPECT_EQ(s.check_invariants(), "");
 }
