@@ -26,19 +26,14 @@ constexpr std::size_t kTiltedGroup = 8;
 // Once: the first caller builds it, a caller meanwhile waits for it.
 void build_offset(SubtractShared& sh, std::size_t o, SubtractStats& stats) {
   SubtractShared::Offset& off = sh.offsets[o];
-  std::atomic_ref<std::uint8_t> state(off.built);
-  std::uint8_t s = state.load(std::memory_order_acquire);
-  if (s == 0 && state.compare_exchange_strong(s, 1, std::memory_order_acq_rel)) {
+  build_once(off.built, [&] {
     ++stats.chain_offsets;
     const SubtractShared::Chain& c = sh.chains[sh.offset_keys[o].chain];
     ClipperLib::ClipperOffset co(2.0, 0.5 * c.shape->chord_tol_mm * kUnitsPerMm);
     co.AddPath(c.pts, ClipperLib::jtRound, ClipperLib::etOpenRound);
     off.paths.clear();
     co.Execute(off.paths, sh.offset_keys[o].r * kUnitsPerMm);
-    state.store(2, std::memory_order_release);
-    return;
-  }
-  while (state.load(std::memory_order_acquire) != 2) cpu_relax();
+  });
 }
 
 namespace {
@@ -395,9 +390,7 @@ const Paths& SubtractEngine::offset_piece(SubtractShared& sh, std::uint32_t o, i
   const Rect rr = grown_region_rect(region);
   if (contains(rr, off.box)) return off.paths;  // wholly inside: nothing to cut
   const std::size_t i = static_cast<std::size_t>((iy - off.iy0) * (off.ix1 - off.ix0 + 1) + (ix - off.ix0));
-  std::atomic_ref<std::uint8_t> state(off.state[i]);
-  std::uint8_t s = state.load(std::memory_order_acquire);
-  if (s == 0 && state.compare_exchange_strong(s, 1, std::memory_order_acq_rel)) {
+  build_once(off.state[i], [&] {
     Paths& out = off.cut[i];
     out.clear();
     ClipperLib::Clipper& k = ws.rect_clipper;
@@ -405,10 +398,7 @@ const Paths& SubtractEngine::offset_piece(SubtractShared& sh, std::uint32_t o, i
     k.AddPaths(off.paths, ClipperLib::ptSubject, true);
     k.AddPath(rect_path(rr), ClipperLib::ptClip, true);
     k.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-    state.store(2, std::memory_order_release);
-  } else {
-    while (state.load(std::memory_order_acquire) != 2) cpu_relax();
-  }
+  });
   return off.cut[i];
 }
 

@@ -99,6 +99,21 @@ struct SubtractShared {
   std::atomic<std::uint8_t> ahead_ready{0};  // the next batch is prepared (SubtractAhead)
 };
 
+// Runs `build` once for a flag shared by threads (0 not built, 1 being built, 2 built): the
+// first caller runs it, a caller meanwhile waits until it is done (a build takes
+// microseconds).
+template <class Build>
+void build_once(std::uint8_t& flag, Build&& build) {
+  std::atomic_ref<std::uint8_t> state(flag);
+  std::uint8_t s = state.load(std::memory_order_acquire);
+  if (s == 0 && state.compare_exchange_strong(s, 1, std::memory_order_acq_rel)) {
+    build();
+    state.store(2, std::memory_order_release);
+    return;
+  }
+  while (state.load(std::memory_order_acquire) != 2) cpu_relax();
+}
+
 // The batch after the current one, prepared during the current one's clips by one thread
 // (`prepare`: SubtractEngine::prepare() into `shared`, and whatever the caller keeps with
 // it); its chain offsets, which depend on the batch only, are then built by the threads
