@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "clip_reach.hpp"
+#include "monotone_union.hpp"
 #include "window_clip.hpp"
 #include "geom/lbr_solid.hpp"
 
@@ -138,8 +139,8 @@ struct SubtractWorkspace {
   Path prev_tilted, tilted_next;              // the last tilted section of a level, untrimmed
   bool prev_tilted_valid = false;
   std::uint32_t prev_tilted_sweep = 0;
-  ClipperLib::Clipper union_clipper;          // joins a group of consecutive tilted sections
-  Paths union_out;
+  MonotoneUnion joined;                       // joins consecutive tilted sections (join_tilted())
+  Paths join_in;                              // the sections being joined
   std::vector<std::uint8_t> trim_flags;
   std::vector<int> source;          // per (level - lb, region): the level whose result it takes
   std::vector<std::uint32_t> jobs;         // (level - lb) * regions + region of the cells to clip

@@ -1002,13 +1002,32 @@ void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, cons
     const double nx = ey / l, ny = -ex / l;  // outward for a counter-clockwise polygon
     p.edges[p.edge_count++] = {nx, ny, nx * a.x + ny * a.y};
   }
-  if (p.edge_count < 3) p.edge_count = 0;  // no area: covers nothing
+  if (p.edge_count < 3) {
+    p.edge_count = 0;  // no area: covers nothing
+    return;
+  }
+  p.cx = p.cy = 0.0;
+  for (int i = 0; i < n; ++i) {
+    p.cx += p.dirs[i].p.x / n;
+    p.cy += p.dirs[i].p.y / n;
+  }
+  p.r_in = INFINITY;
+  p.r_out2 = 0.0;
+  for (int i = 0; i < p.edge_count; ++i) p.r_in = std::min(p.r_in, p.edges[i].c - (p.edges[i].nx * p.cx + p.edges[i].ny * p.cy));
+  for (int i = 0; i < n; ++i) {
+    const double dx = p.dirs[i].p.x - p.cx, dy = p.dirs[i].p.y - p.cy;
+    p.r_out2 = std::max(p.r_out2, dx * dx + dy * dy);
+  }
 }
 
 }  // namespace
 
 bool TiltedPiece::covers(const SectionScratch::P2& q, double margin_mm) const noexcept {
   if (edge_count == 0 || q.x <= x0 || q.x >= x1 || q.y <= y0 || q.y >= y1) return false;
+  const double dx = q.x - cx, dy = q.y - cy, d2 = dx * dx + dy * dy;
+  if (d2 >= r_out2) return false;  // outside the disk around Q (margin_mm >= 0)
+  const double r = r_in - margin_mm;
+  if (r > 0.0 && d2 < r * r) return true;  // inside the disk in Q, by the margin
   for (int i = 0; i < edge_count; ++i)
     if (edges[i].nx * q.x + edges[i].ny * q.y > edges[i].c - margin_mm) return false;
   return true;

@@ -115,6 +115,9 @@ struct TiltedPiece {
   Edge edges[kDirs];
   int edge_count = 0;
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // Q's box [mm]
+  // A disk inside Q and one around it, both about the mean of Q's points [mm]: most points
+  // are decided by one of them without Q's edges.
+  double cx = 0, cy = 0, r_in = 0, r_out2 = 0;
   [[nodiscard]] bool covers(const SectionScratch::P2& p, double margin_mm) const noexcept;
 };
 
