@@ -52,7 +52,6 @@ void begin_reach(LevelSections& ls, std::size_t k) {
 void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                                  SubtractStats& stats) const {
   const double zc = s_.level_z_mm(level);
-  ws.prev_tilted_valid = false;
   for (Path& p : ls.paths) ws.scratch.spare.push_back(std::move(p));  // keep the buffers
   ls.paths.clear();
   ls.box.clear();
@@ -296,7 +295,7 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
 // The sections of the pending tilted pieces (ws.pieces, consecutive sub-steps of a run's
 // tilted sweeps on this level), each refined only where neither neighbour's coarse polygon
 // covers its arcs (Sweep::build_piece(): all of them go into this level's one difference),
-// then trimmed by the previous one (trim_tilted()) and joined in groups (join_tilted()).
+// then joined in groups (join_tilted()).
 void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                                   SubtractStats& stats) const {
   const std::size_t n = ws.pieces.size();
@@ -306,7 +305,6 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
     const std::size_t before = ls.paths.size();
     sh.sweeps[p.sweep].build_piece(p, i > 0 ? &ws.pieces[i - 1] : nullptr, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
                                    ls.paths, ws.scratch);
-    trim_tilted(p.sweep, before, sh, ws, ls, stats);
     if (ls.paths.size() > before) id = std::max(id, sh.sweep_id[p.sweep]);
     if (ls.paths.size() - ls.box.size() >= kTiltedGroup) {
       join_tilted(ls.box.size(), id, ws, ls, stats);
@@ -363,39 +361,6 @@ void SubtractEngine::join_tilted(std::size_t begin, MoveId id, SubtractWorkspace
     ls.id.push_back(id);
     ls.all.add(ls.box.back());
   }
-}
-
-// A tilted move's sections (one per sub-step) on a level overlap the previous sub-step's and
-// the previous tilted move's as much as vertical ones do: each is trimmed by the previous
-// one as it was before its own trimming (convex; trim_covered() with a polygon). Any
-// untrimmed section of this level is a valid cover (what trimming took from it lies in its
-// own cover, which is removed in the same difference); the previous move's is the useful one.
-void SubtractEngine::trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
-                           LevelSections& ls, SubtractStats& stats) const {
-  const Sweep& sw = sh.sweeps[si];
-  bool covered = ws.prev_tilted_valid &&
-                 (ws.prev_tilted_sweep == si || (ws.prev_tilted_sweep + 1 == si && &sh.sweeps[si - 1].shape() == &sw.shape() &&
-                                                 sh.sweeps[si - 1].to().tip == sw.from().tip));
-  std::size_t w = before;
-  for (std::size_t k = before; k < ls.paths.size(); ++k) {
-    ws.tilted_next = ls.paths[k];
-    bool keep = true;
-    if (covered) {
-      const std::size_t vertices = ls.paths[k].size();
-      keep = trim_covered(ls.paths[k], ws.prev_tilted, ws.trim_flags);
-      if (!keep || ls.paths[k].size() != vertices) ++stats.sections_trimmed;
-    }
-    ws.prev_tilted.swap(ws.tilted_next);
-    ws.prev_tilted_valid = covered = true;
-    ws.prev_tilted_sweep = si;
-    if (!keep) {
-      ws.scratch.spare.push_back(std::move(ls.paths[k]));
-      continue;
-    }
-    if (w != k) ls.paths[w] = std::move(ls.paths[k]);
-    ++w;
-  }
-  ls.paths.resize(w);
 }
 
 // The chain offset `o` cut to `region` (grown by 1 mm); the first thread that needs a piece

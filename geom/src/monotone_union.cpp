@@ -27,7 +27,7 @@ using Fn = std::span<const P>;  // a piecewise linear function: points with stri
 constexpr double kSlack = 0.5;
 
 // The value of f at x (within f's domain), from the segment ending at index i (f[i].x >= x).
-double value_at(Fn f, std::size_t i, double x) noexcept {
+inline double value_at(Fn f, std::size_t i, double x) noexcept {
   const P& b = f[i];
   if (b.x == x || i == 0) return b.y;
   const P& a = f[i - 1];
@@ -189,23 +189,32 @@ bool MonotoneUnion::chains_of(const Path& poly) {
 
 bool MonotoneUnion::add(const Path& poly) {
   if (!chains_of(poly)) return false;
-  if (count_++ == 0) {
-    up_.swap(cu_);
-    lo_.swap(cl_);
-    return true;
-  }
-  // The polygon's interval meets the union's on every line both reach: l <= U, L <= u.
-  const std::size_t ku = tail_start(up_, cu_), kl = tail_start(lo_, cl_);
-  if (!sum_nonneg(Fn(up_).subspan(ku), cl_) || !sum_nonneg(cu_, Fn(lo_).subspan(kl)) ||
-      !merge_max(Fn(up_).subspan(ku), cu_, tmp_) || !merge_max(Fn(lo_).subspan(kl), cl_, tmp2_)) {
-    --count_;
+  if (count_ == 0) {
+    up_.assign(cu_.begin(), cu_.end());
+    lo_.assign(cl_.begin(), cl_.end());
+  } else if (!meets_union() || !merge_max(Fn(up_).subspan(tail_start(up_, cu_)), cu_, tmp_) ||
+             !merge_max(Fn(lo_).subspan(tail_start(lo_, cl_)), cl_, tmp2_)) {
     return false;
+  } else {
+    up_.resize(tail_start(up_, cu_));
+    up_.insert(up_.end(), tmp_.begin(), tmp_.end());
+    lo_.resize(tail_start(lo_, cl_));
+    lo_.insert(lo_.end(), tmp2_.begin(), tmp2_.end());
   }
-  up_.resize(ku);
-  up_.insert(up_.end(), tmp_.begin(), tmp_.end());
-  lo_.resize(kl);
-  lo_.insert(lo_.end(), tmp2_.begin(), tmp2_.end());
+  ++count_;
+  pu_.swap(cu_);
+  pl_.swap(cl_);
   return true;
+}
+
+// The polygon's interval meets the union's on every line x = const both reach: l <= U and
+// L <= u. Where the union's domain within the polygon's lies in the previous polygon's,
+// meeting the previous polygon there is enough (its interval lies in the union's), and its
+// chains are shorter than the envelopes.
+bool MonotoneUnion::meets_union() const {
+  const double lo = std::max(cu_.front().x, up_.front().x), hi = std::min(cu_.back().x, up_.back().x);
+  if (pu_.front().x <= lo && hi <= pu_.back().x) return sum_nonneg(pu_, cl_) && sum_nonneg(cu_, pl_);
+  return sum_nonneg(Fn(up_).subspan(tail_start(up_, cu_)), cl_) && sum_nonneg(cu_, Fn(lo_).subspan(tail_start(lo_, cl_)));
 }
 
 void MonotoneUnion::write(Path& out) const {

@@ -40,11 +40,13 @@ class MonotoneUnion {
   [[nodiscard]] P to_frame(const Point& q) const noexcept;
   [[nodiscard]] Point from_frame(double x, double y) const noexcept;
   [[nodiscard]] bool chains_of(const Path& poly);
+  [[nodiscard]] bool meets_union() const;
 
   int quarter_ = 0;  // the frame is the plane turned by −90°·quarter_
   std::size_t count_ = 0;
   std::vector<P> up_, lo_;  // the union's upper envelope, and its lower envelope negated
   std::vector<P> cu_, cl_;  // the polygon being added: its upper chain, its lower chain negated
+  std::vector<P> pu_, pl_;  // the same of the polygon added last
   std::vector<P> pts_;      // the polygon being added, in the frame
   std::vector<P> tmp_, tmp2_;  // the merges' output (upper, lower)
 };

@@ -58,8 +58,6 @@ class SubtractEngine {
                           const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   void build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   static void join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats);
-  void trim_tilted(std::uint32_t si, std::size_t before, const SubtractShared& sh, SubtractWorkspace& ws,
-                   LevelSections& ls, SubtractStats& stats) const;
   static void add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls);
   void add_lathe_sections(double zc, const SubtractShared& sh, LevelSections& ls) const;
   const Paths& offset_piece(SubtractShared& sh, std::uint32_t o, int region, SubtractWorkspace& ws,

@@ -136,9 +136,6 @@ struct SubtractWorkspace {
   std::vector<SectionScratch::P2> outline;    // a joined run's vertices before rounding
   Path cut, cut_tmp;                          // a long section cut to a region
   std::vector<TiltedPiece> pieces;            // a run's tilted sub-steps on one level, pending
-  Path prev_tilted, tilted_next;              // the last tilted section of a level, untrimmed
-  bool prev_tilted_valid = false;
-  std::uint32_t prev_tilted_sweep = 0;
   MonotoneUnion joined;                       // joins consecutive tilted sections (join_tilted())
   Paths join_in;                              // the sections being joined
   std::vector<std::uint8_t> trim_flags;

@@ -777,41 +777,6 @@ bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, d
   return trim_inside(b, flags, inside);
 }
 
-bool trim_covered(Path& b, const Path& a, std::vector<std::uint8_t>& flags, double margin) {
-  const std::size_t na = a.size();
-  if (na < 3 || b.size() < 4) return true;
-  // a is convex and counter-clockwise: the wedge from a[0] that holds q, then q's distance
-  // to that wedge's edge and its neighbours (the edges a point near a vertex is nearest to).
-  const Rect box = bounds_of(a);
-  // q lies at least `margin` inside edge i -> i+1 (its signed distance c / |e| >= margin),
-  // compared squared for a positive margin (no square root per test).
-  auto beyond = [&](std::size_t i, const Point& q) {
-    const Point& p0 = a[i];
-    const Point& p1 = a[(i + 1) % na];
-    const double ex = static_cast<double>(p1.X - p0.X), ey = static_cast<double>(p1.Y - p0.Y);
-    const double l2 = ex * ex + ey * ey;  // integer units: no overflow
-    const double c = ex * static_cast<double>(q.Y - p0.Y) - ey * static_cast<double>(q.X - p0.X);
-    if (margin <= 0.0) return l2 > 0.0 ? c >= margin * std::sqrt(l2) : c >= margin;
-    return c > 0.0 && c * c >= margin * margin * l2;
-  };
-  auto cross0 = [&](std::size_t i, const Point& q) {
-    return static_cast<double>(a[i].X - a[0].X) * static_cast<double>(q.Y - a[0].Y) -
-           static_cast<double>(a[i].Y - a[0].Y) * static_cast<double>(q.X - a[0].X);
-  };
-  auto inside = [&](const Point& q) {
-    if (q.X <= box.x0 || q.X >= box.x1 || q.Y <= box.y0 || q.Y >= box.y1) return false;
-    if (cross0(1, q) <= 0.0 || cross0(na - 1, q) >= 0.0) return false;
-    std::size_t lo = 1, hi = na - 1;  // q lies between rays a0->a[lo] and a0->a[hi]
-    while (hi - lo > 1) {
-      const std::size_t mid = (lo + hi) / 2;
-      if (cross0(mid, q) > 0.0) lo = mid;
-      else hi = mid;
-    }
-    return beyond(lo, q) && beyond((lo + na - 1) % na, q) && beyond(hi % na, q);
-  };
-  return trim_inside(b, flags, inside);
-}
-
 const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {
   if (static_cast<std::size_t>(n) >= circles_.size()) circles_.resize(static_cast<std::size_t>(n) + 1);
   auto& c = circles_[static_cast<std::size_t>(n)];

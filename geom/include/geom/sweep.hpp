@@ -122,9 +122,6 @@ struct TiltedPiece {
 };
 
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
-// The same with a convex counter-clockwise polygon `a` (the previous tilted section) as the
-// covering region: O(log |a|) per vertex of b.
-bool trim_covered(Path& b, const Path& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
 
 class Sweep {
  public:
