@@ -851,7 +851,7 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
     if (!(det > 1e-12)) return false;
     const P2 apex{(ha * by - hb * ay) / det, (ax * hb - bx * ha) / det};
     for (const TiltedPiece* c : {cover0, cover1})
-      if (c != nullptr && c->covers(iv.a, margin) && c->covers(iv.b, margin) && c->covers(apex, margin)) return true;
+      if (c != nullptr && c->covers(apex, margin) && c->covers(iv.a, margin) && c->covers(iv.b, margin)) return true;
     return false;
   };
   sc.pts.clear();
