@@ -1,6 +1,6 @@
 // The union of consecutive convex polygons that follow a path, without a sweep-line clip:
 // the region between their upper and lower envelopes along the path's main axis
-// (docs/lbr-conventions.md, "Joined tilted sections").
+// (docs/lbr-conventions.md, "Joined sections", tilted moves).
 #pragma once
 
 #include <vector>
