@@ -304,3 +304,75 @@ TEST(LbrSolid, UpdateCopySliceCopiesAtMostItsBudgetAndCatchesUp) {
   EXPECT_EQ(changed(), 0u);
   EXPECT_DOUBLE_EQ(slot.volume_mm3(), live.volume_mm3());
 }
+
+namespace {
+
+// A tilted ball raster (Ø6, axis turning from 10° to 30° about x along 40 moves of 0.5 mm),
+// as a 5-axis finishing pass sends it.
+std::vector<geom::SweepRef> tilted_pass(const geom::CutterShape& ball, std::size_t first, std::size_t count) {
+  std::vector<geom::SweepRef> moves;
+  auto pose = [](std::size_t i) {
+    const double a = (10.0 + 0.5 * static_cast<double>(i)) * test::kPi / 180.0;
+    return geom::Pose{{5.0 + 0.5 * static_cast<double>(i), 15.0, -2.0 - 0.02 * static_cast<double>(i)}, {0.0, -std::sin(a), std::cos(a)}};
+  };
+  for (std::size_t i = first; i < first + count; ++i) moves.push_back({&ball, pose(i), pose(i + 1), static_cast<geom::MoveId>(i + 1)});
+  return moves;
+}
+
+geom::SolidSpec tilted_test_spec() {
+  geom::SolidSpec spec;
+  spec.box = {{0, 0, -6}, {40, 30, 0}};
+  spec.level_spacing_mm = 0.1;
+  spec.regions_x = 4;
+  spec.regions_y = 3;
+  return spec;
+}
+
+void expect_same_cells(const geom::LbrSolid& a, const geom::LbrSolid& b) {
+  for (int r = 0; r < a.regions(); ++r)
+    for (int l = 0; l < a.levels(); ++l) {
+      const geom::Cell& x = a.cell(r, l);
+      const geom::Cell& y = b.cell(r, l);
+      ASSERT_EQ(x.polys.size(), y.polys.size()) << r << " " << l;
+      for (std::size_t p = 0; p < x.polys.size(); ++p) ASSERT_EQ(x.polys[p].outer.pts, y.polys[p].outer.pts) << r << " " << l;
+    }
+}
+
+}  // namespace
+
+// A live stream subtracts a tilted pass a move or two at a time: each level's first piece of
+// a call takes the level's last piece of the call before as its cover (level_sections.cpp,
+// level_prior()). The part is the one the whole pass in one call gives, within the tolerance
+// the covers keep (each piece's section within the chord tolerance of its own).
+TEST(LbrSolid, ATiltedPassMoveByMoveRemovesWhatItRemovesInOneCall) {
+  const geom::CutterShape ball = geom::CutterShape::build(test::tool(ToolKind::Ball, 6.0, 18.0), 0.01);
+  const std::vector<geom::SweepRef> pass = tilted_pass(ball, 0, 40);
+  geom::LbrSolid whole(tilted_test_spec()), by_move(tilted_test_spec());
+  whole.subtract(pass);
+  for (const geom::SweepRef& m : pass) by_move.subtract(std::span<const geom::SweepRef>(&m, 1));
+  const double removed = test::removed(whole);
+  ASSERT_GT(removed, 250.0);
+  // The boundaries differ by at most the chord tolerance: 0.01 mm over the pass's wetted
+  // outline (2 x 26 mm long, 6 mm high on each level's sides, both ends): < 4 mm³.
+  EXPECT_NEAR(test::removed(by_move), removed, 0.01 * (2.0 * 26.0 + 2.0 * 6.0) * 6.0);
+  EXPECT_EQ(by_move.check_invariants(), "");
+}
+
+// Covers last only while nothing is put back: after update_copy_of() restores the stock, the
+// next tilted move (starting where the last one ended, so its pieces lie mostly inside the
+// last ones) builds every section whole, as on a fresh solid: the same cells, vertex for vertex.
+TEST(LbrSolid, MaterialPutBackEndsTheTiltedCovers) {
+  const geom::CutterShape ball = geom::CutterShape::build(test::tool(ToolKind::Ball, 6.0, 18.0), 0.01);
+  const std::vector<geom::SweepRef> first = tilted_pass(ball, 0, 10), second = tilted_pass(ball, 10, 1);
+  const geom::LbrSolid stock(tilted_test_spec());
+  geom::LbrSolid reused(tilted_test_spec()), fresh(tilted_test_spec());
+  const std::uint64_t epoch = reused.removal_epoch();
+  reused.subtract(first);
+  EXPECT_EQ(reused.removal_epoch(), epoch);  // subtracting keeps it
+  reused.update_copy_of(stock);
+  EXPECT_NE(reused.removal_epoch(), epoch);
+  ASSERT_DOUBLE_EQ(reused.volume_mm3(), stock.volume_mm3());
+  reused.subtract(second);
+  fresh.subtract(second);
+  expect_same_cells(reused, fresh);
+}

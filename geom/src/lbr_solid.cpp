@@ -3,6 +3,7 @@
 #include "geom/lbr_solid.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -82,6 +83,11 @@ double LbrSolid::level_count(const SolidSpec& spec) noexcept {
 }
 
 LbrSolid::~LbrSolid() = default;
+std::uint64_t LbrSolid::next_epoch() noexcept {
+  static std::atomic<std::uint64_t> counter{0};
+  return counter.fetch_add(1, std::memory_order_relaxed) + 1;
+}
+
 LbrSolid::LbrSolid(LbrSolid&&) noexcept = default;
 LbrSolid& LbrSolid::operator=(LbrSolid&&) noexcept = default;
 LbrSolid::LbrSolid(const LbrSolid& o)
@@ -114,6 +120,7 @@ std::size_t LbrSolid::update_copy_slice(const LbrSolid& o, std::size_t from, std
     versions_[i] = o.versions_[i];
     ++copied;
   }
+  if (copied > 0) epoch_ = next_epoch();
   if (i < cells_.size()) return i;
   spec_ = o.spec_;
   z0_ = o.z0_;
@@ -347,6 +354,7 @@ void LbrSolid::set_cell(int region, int level, std::vector<Polygon> polys, MoveI
   for (Polygon& p : c.polys) p.bbox = bounds_of(p.outer.pts);
   detail::refresh_cell(c);
   changed(i);
+  epoch_ = next_epoch();
 }
 
 SubtractStats LbrSolid::subtract(std::span<const SweepRef> batch) { return detail::SubtractEngine(*this).subtract(batch, *ws_); }

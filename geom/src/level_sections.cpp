@@ -299,11 +299,13 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
 void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                                   SubtractStats& stats) const {
   const std::size_t n = ws.pieces.size();
+  if (n == 0) return;
+  const TiltedPiece* prior = level_prior(ws.pieces.front().zc, ws);
   MoveId id = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const TiltedPiece& p = ws.pieces[i];
     const std::size_t before = ls.paths.size();
-    sh.sweeps[p.sweep].build_piece(p, i > 0 ? &ws.pieces[i - 1] : nullptr, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
+    sh.sweeps[p.sweep].build_piece(p, i > 0 ? &ws.pieces[i - 1] : prior, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
                                    ls.paths, ws.scratch);
     if (ls.paths.size() > before) id = std::max(id, sh.sweep_id[p.sweep]);
     if (ls.paths.size() - ls.box.size() >= kTiltedGroup) {
@@ -312,7 +314,26 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
     }
   }
   if (ls.paths.size() > ls.box.size()) join_tilted(ls.box.size(), id, ws, ls, stats);
+  const std::size_t level = static_cast<std::size_t>(s_.level_at(ws.pieces.front().zc));
+  ws.level_last[level] = ws.pieces.back();
+  ws.level_last_set[level] = 1;
   ws.pieces.clear();
+}
+
+// The last tilted piece this workspace built on the level of plane zc, when the solid has
+// not had material put back since (LbrSolid::removal_epoch()): its coarse polygon lies in
+// material already removed, or removed in this difference, so the level's next piece need
+// not refine its boundary where a refinement triangle lies in it (Sweep::build_piece()).
+// A live call holds one or two pieces per level, which had no cover before their first.
+const TiltedPiece* SubtractEngine::level_prior(double zc, SubtractWorkspace& ws) const {
+  const std::size_t levels = static_cast<std::size_t>(s_.levels());
+  if (ws.level_last_epoch != s_.removal_epoch() || ws.level_last.size() != levels) {
+    ws.level_last.resize(levels);
+    ws.level_last_set.assign(levels, 0);
+    ws.level_last_epoch = s_.removal_epoch();
+  }
+  const std::size_t level = static_cast<std::size_t>(s_.level_at(zc));
+  return ws.level_last_set[level] != 0 ? &ws.level_last[level] : nullptr;
 }
 
 // The tilted sections ls.paths[begin..] (consecutive sub-steps and moves of one run, each

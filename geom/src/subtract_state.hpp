@@ -136,6 +136,12 @@ struct SubtractWorkspace {
   std::vector<SectionScratch::P2> outline;    // a joined run's vertices before rounding
   Path cut, cut_tmp;                          // a long section cut to a region
   std::vector<TiltedPiece> pieces;            // a run's tilted sub-steps on one level, pending
+  // Per level, the last tilted piece this workspace built there, while the solid's
+  // removal_epoch() is level_last_epoch: its coarse polygon lies in material already removed
+  // (or removed in the same difference), so it covers the next piece there (build_tilted()).
+  std::vector<TiltedPiece> level_last;
+  std::vector<std::uint8_t> level_last_set;
+  std::uint64_t level_last_epoch = 0;
   MonotoneUnion joined;                       // joins consecutive tilted sections (join_tilted())
   Paths join_in;                              // the sections being joined
   std::vector<std::uint8_t> trim_flags;

@@ -172,6 +172,10 @@ class LbrSolid {
   // The same levels and region borders: update_copy_slice() may be used.
   [[nodiscard]] bool same_grid(const LbrSolid& o) const noexcept;
   [[nodiscard]] std::size_t cell_count() const noexcept { return cells_.size(); }
+  // Changes whenever material may have been put back (construction, copy, update_copy_*,
+  // set_cell), never by a subtraction: what a subtraction removed under one epoch stays
+  // removed while it lasts (the kernel keeps such regions as covers, level_sections.cpp).
+  [[nodiscard]] std::uint64_t removal_epoch() const noexcept { return epoch_; }
 
   // Removes the union of the sweeps from the stock: per (region, level) touched, one
   // polygon difference. Cells are skipped by bounding boxes first. Changed cells are marked
@@ -260,6 +264,8 @@ class LbrSolid {
   // reading 4 bytes per cell, not a cache line of each Cell.
   std::vector<std::uint32_t> versions_;
   double initial_volume_mm3_ = 0;
+  std::uint64_t epoch_ = next_epoch();  // removal_epoch()
+  [[nodiscard]] static std::uint64_t next_epoch() noexcept;
   std::unique_ptr<detail::SubtractWorkspace> ws_;  // for subtract() and subtract_solid()
 };
 
