@@ -213,14 +213,17 @@ TEST(LbrSolid, RegressionAStripOneUnitWideIsRemovedByAPassOverIt) {
 }
 
 // The snapshot slot tests' stock: 40 x 30 x 10 mm in 4 x 3 regions, levels 0.5 mm apart.
-geom::SolidSpec snapshot_test_spec() {
+// A 40 x 30 mm box stock from z_min to 0 on a 4x3 grid.
+geom::SolidSpec box_40x30(double z_min, double spacing) {
   geom::SolidSpec spec;
-  spec.box = {{0, 0, -10}, {40, 30, 0}};
-  spec.level_spacing_mm = 0.5;
+  spec.box = {{0, 0, z_min}, {40, 30, 0}};
+  spec.level_spacing_mm = spacing;
   spec.regions_x = 4;
   spec.regions_y = 3;
   return spec;
 }
+
+geom::SolidSpec snapshot_test_spec() { return box_40x30(-10.0, 0.5); }
 
 // A snapshot slot follows the live solid by copying only the cells that changed since its
 // last copy (LbrSolid::update_copy_of): the result equals a full copy, and a cell that did
@@ -319,14 +322,7 @@ std::vector<geom::SweepRef> tilted_pass(const geom::CutterShape& ball, std::size
   return moves;
 }
 
-geom::SolidSpec tilted_test_spec() {
-  geom::SolidSpec spec;
-  spec.box = {{0, 0, -6}, {40, 30, 0}};
-  spec.level_spacing_mm = 0.1;
-  spec.regions_x = 4;
-  spec.regions_y = 3;
-  return spec;
-}
+geom::SolidSpec tilted_test_spec() { return box_40x30(-6.0, 0.1); }
 
 void expect_same_cells(const geom::LbrSolid& a, const geom::LbrSolid& b) {
   for (int r = 0; r < a.regions(); ++r)
