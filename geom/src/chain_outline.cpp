@@ -99,12 +99,7 @@ struct Walker {
 // Rounds to kernel units, dropping repeated vertices and vertices collinear with their
 // neighbours (exact integer test: the region is unchanged).
 bool emit_path(const std::vector<P2>& pts, Paths& out, std::vector<Path>& spare) {
-  Path p;
-  if (!spare.empty()) {
-    p = std::move(spare.back());
-    spare.pop_back();
-    p.clear();
-  }
+  Path p = SectionScratch::take_spare(spare);
   p.reserve(pts.size());
   auto collinear = [](const Point& a, const Point& b, const Point& c) {
     // |coordinates| < 2^30 (the safe range): the products stay below 2^63.

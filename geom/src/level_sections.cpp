@@ -300,7 +300,8 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
                                   SubtractStats& stats) const {
   const std::size_t n = ws.pieces.size();
   if (n == 0) return;
-  const TiltedPiece* prior = level_prior(ws.pieces.front().zc, ws);
+  const std::size_t level = static_cast<std::size_t>(s_.level_at(ws.pieces.front().zc));
+  const TiltedPiece* prior = level_prior(level, ws);
   MoveId id = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const TiltedPiece& p = ws.pieces[i];
@@ -314,25 +315,23 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
     }
   }
   if (ls.paths.size() > ls.box.size()) join_tilted(ls.box.size(), id, ws, ls, stats);
-  const std::size_t level = static_cast<std::size_t>(s_.level_at(ws.pieces.front().zc));
   ws.level_last[level] = ws.pieces.back();
   ws.level_last_set[level] = 1;
   ws.pieces.clear();
 }
 
-// The last tilted piece this workspace built on the level of plane zc, when the solid has
+// The last tilted piece this workspace built on `level`, when the solid has
 // not had material put back since (LbrSolid::removal_epoch()): its coarse polygon lies in
 // material already removed, or removed in this difference, so the level's next piece need
 // not refine its boundary where a refinement triangle lies in it (Sweep::build_piece()).
 // A live call holds one or two pieces per level, which had no cover before their first.
-const TiltedPiece* SubtractEngine::level_prior(double zc, SubtractWorkspace& ws) const {
+const TiltedPiece* SubtractEngine::level_prior(std::size_t level, SubtractWorkspace& ws) const {
   const std::size_t levels = static_cast<std::size_t>(s_.levels());
   if (ws.level_last_epoch != s_.removal_epoch() || ws.level_last.size() != levels) {
     ws.level_last.resize(levels);
     ws.level_last_set.assign(levels, 0);
     ws.level_last_epoch = s_.removal_epoch();
   }
-  const std::size_t level = static_cast<std::size_t>(s_.level_at(zc));
   return ws.level_last_set[level] != 0 ? &ws.level_last[level] : nullptr;
 }
 
@@ -366,11 +365,7 @@ void SubtractEngine::join_tilted(std::size_t begin, MoveId id, SubtractWorkspace
       i = std::max(j, i + 1);
       continue;
     }
-    ls.paths.emplace_back();
-    if (!ws.scratch.spare.empty()) {
-      ls.paths.back().swap(ws.scratch.spare.back());
-      ws.scratch.spare.pop_back();
-    }
+    ls.paths.push_back(SectionScratch::take_spare(ws.scratch.spare));
     u.write(ls.paths.back());
     stats.sections_joined += j - i;
     i = j;

@@ -192,13 +192,14 @@ bool MonotoneUnion::add(const Path& poly) {
   if (count_ == 0) {
     up_.assign(cu_.begin(), cu_.end());
     lo_.assign(cl_.begin(), cl_.end());
-  } else if (!meets_union() || !merge_max(Fn(up_).subspan(tail_start(up_, cu_)), cu_, tmp_) ||
-             !merge_max(Fn(lo_).subspan(tail_start(lo_, cl_)), cl_, tmp2_)) {
-    return false;
   } else {
-    up_.resize(tail_start(up_, cu_));
+    // The envelopes' vertices from ku and kl on are those the polygon can change.
+    const std::size_t ku = tail_start(up_, cu_), kl = tail_start(lo_, cl_);
+    if (!meets_union(ku, kl) || !merge_max(Fn(up_).subspan(ku), cu_, tmp_) || !merge_max(Fn(lo_).subspan(kl), cl_, tmp2_))
+      return false;
+    up_.resize(ku);
     up_.insert(up_.end(), tmp_.begin(), tmp_.end());
-    lo_.resize(tail_start(lo_, cl_));
+    lo_.resize(kl);
     lo_.insert(lo_.end(), tmp2_.begin(), tmp2_.end());
   }
   ++count_;
@@ -208,13 +209,13 @@ bool MonotoneUnion::add(const Path& poly) {
 }
 
 // The polygon's interval meets the union's on every line x = const both reach: l <= U and
-// L <= u. Where the union's domain within the polygon's lies in the previous polygon's,
-// meeting the previous polygon there is enough (its interval lies in the union's), and its
-// chains are shorter than the envelopes.
-bool MonotoneUnion::meets_union() const {
+// L <= u (the envelopes from ku and kl on). Where the union's domain within the polygon's
+// lies in the previous polygon's, meeting the previous polygon there is enough (its interval
+// lies in the union's), and its chains are shorter than the envelopes.
+bool MonotoneUnion::meets_union(std::size_t ku, std::size_t kl) const {
   const double lo = std::max(cu_.front().x, up_.front().x), hi = std::min(cu_.back().x, up_.back().x);
   if (pu_.front().x <= lo && hi <= pu_.back().x) return sum_nonneg(pu_, cl_) && sum_nonneg(cu_, pl_);
-  return sum_nonneg(Fn(up_).subspan(tail_start(up_, cu_)), cl_) && sum_nonneg(cu_, Fn(lo_).subspan(tail_start(lo_, cl_)));
+  return sum_nonneg(Fn(up_).subspan(ku), cl_) && sum_nonneg(cu_, Fn(lo_).subspan(kl));
 }
 
 void MonotoneUnion::write(Path& out) const {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "geom/lbr_solid.hpp"
+#include "geom/sweep.hpp"
 
 namespace lbr::geom::detail {
 
@@ -16,9 +17,7 @@ namespace lbr::geom::detail {
 // and that overlap. Reuses its buffers; allocates only when they grow. One per thread.
 class MonotoneUnion {
  public:
-  struct P {
-    double x, y;
-  };
+  using P = SectionScratch::P2;
 
   // Starts an empty union whose path runs in direction (dx, dy) [any units].
   void begin(double dx, double dy) noexcept;
@@ -40,7 +39,7 @@ class MonotoneUnion {
   [[nodiscard]] P to_frame(const Point& q) const noexcept;
   [[nodiscard]] Point from_frame(double x, double y) const noexcept;
   [[nodiscard]] bool chains_of(const Path& poly);
-  [[nodiscard]] bool meets_union() const;
+  [[nodiscard]] bool meets_union(std::size_t ku, std::size_t kl) const;
 
   int quarter_ = 0;  // the frame is the plane turned by −90°·quarter_
   std::size_t count_ = 0;

@@ -57,7 +57,7 @@ class SubtractEngine {
   void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const Rect& material,
                           const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   void build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
-  const TiltedPiece* level_prior(double zc, SubtractWorkspace& ws) const;
+  const TiltedPiece* level_prior(std::size_t level, SubtractWorkspace& ws) const;
   static void join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats);
   static void add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls);
   void add_lathe_sections(double zc, const SubtractShared& sh, LevelSections& ls) const;

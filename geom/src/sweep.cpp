@@ -60,12 +60,7 @@ void convex_hull(std::vector<P2>& pts, std::vector<P2>& hull) {
 // buffer comes from `spare` when it has one (no allocation once the pool has grown).
 std::size_t emit(const std::vector<P2>& hull, Paths& out, std::vector<Path>& spare) {
   if (hull.size() < 3) return 0;
-  Path p;
-  if (!spare.empty()) {
-    p = std::move(spare.back());
-    spare.pop_back();
-    p.clear();
-  }
+  Path p = SectionScratch::take_spare(spare);
   p.reserve(hull.size());
   for (const P2& q : hull) {
     const Point ip{to_units(q.x), to_units(q.y)};

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "geom/tool.hpp"
@@ -66,6 +67,17 @@ struct SectionScratch {
   Capsule core;
   // Emptied paths whose buffers section() reuses (callers may give theirs back).
   std::vector<Path> spare;
+  // An empty path, with the buffer of a spare one when there is one (no allocation once
+  // the pool has grown).
+  [[nodiscard]] static Path take_spare(std::vector<Path>& spare) noexcept {
+    Path p;
+    if (!spare.empty()) {
+      p = std::move(spare.back());
+      spare.pop_back();
+      p.clear();
+    }
+    return p;
+  }
   // Unit circle with n vertices, (cos, sin) pairs, built on first use of each n.
   [[nodiscard]] const std::vector<P2>& unit_circle(int n);
 
@@ -73,12 +85,6 @@ struct SectionScratch {
   std::vector<std::vector<P2>> circles_;
 };
 
-// Removes from convex polygon `b` (counter-clockwise, kernel units) the vertices that lie
-// inside capsule `a` by at least `margin` units, keeping the first and last vertex of each
-// such run. What b loses is the convex hull of a run, which lies inside a, so b' ⊆ b and
-// a ∪ b' = a ∪ b: when a's polygon is removed from the stock in the same operation, b' does
-// the same work with fewer edges. Returns false when every vertex of b lies inside a (b is
-// then unchanged and can be dropped). `flags` is a reusable buffer.
 // The section of one vertical move on one plane, split for joining consecutive moves into
 // one outline (geom/src/chain_outline.cpp). All vertices lie on one angle grid of n
 // directions: the start disk J0 (centre c0, circumradius rho0) and the end disk J1 carry
@@ -121,6 +127,12 @@ struct TiltedPiece {
   [[nodiscard]] bool covers(const SectionScratch::P2& p, double margin_mm) const noexcept;
 };
 
+// Removes from convex polygon `b` (counter-clockwise, kernel units) the vertices that lie
+// inside capsule `a` by at least `margin` units, keeping the first and last vertex of each
+// such run. What b loses is the convex hull of a run, which lies inside a, so b' ⊆ b and
+// a ∪ b' = a ∪ b: when a's polygon is removed from the stock in the same operation, b' does
+// the same work with fewer edges. Returns false when every vertex of b lies inside a (b is
+// then unchanged and can be dropped). `flags` is a reusable buffer.
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
 
 class Sweep {
