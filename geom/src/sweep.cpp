@@ -113,9 +113,17 @@ int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
 // only the cylinder's flat top becomes a hemisphere, which lies inside the shank above it.
 // The sub-step's hull is then Q ⊕ B(r), Q the tetrahedron of the two poses' segment ends,
 // and its section has a closed-form support point in every direction (capsule_point()).
+// A bull-nose mill (CutterShape::core_radius_mm) is taken the same way with a disk of radius
+// ρ (its flat end's) in place of each segment end: the points within its corner radius of
+// that disk swept along the axis from the corner's centre to the top of the flutes. The
+// sub-step's hull is then conv(four disks) ⊕ B(r), whose support is the best of the four
+// disks' plus r along the direction (core_support()): the profile's exact torus instead of
+// its polyline, and the tilt search's height z(t) is smooth but for the switches between the
+// four disks, not a staircase of station bands.
 struct Hull3 {
   Hull3(const CutterShape* s, const Pose& a, const Pose& b) noexcept : shape(s), pose{a, b} {
     cap_r = s->capsule_radius_mm;
+    core = s->core_radius_mm;
     if (cap_r <= 0.0) return;
     const double top = s->height();
     q[0] = p3(a.tip + cap_r * a.axis);
@@ -126,11 +134,13 @@ struct Hull3 {
   const CutterShape* shape;
   Pose pose[2];
   double cap_r = 0.0;  // > 0: the capsule model (q: the segment ends at both poses)
+  double core = 0.0;   // > 0 with cap_r: the rounded core model (q: the core disks' centres)
   P3 q[4];  // a.centre, a.top, b.centre, b.top (set only for the capsule: no initialisers)
   mutable std::size_t last_station[2] = {0, 0};  // each pose's best station of the last query
   mutable std::uint32_t queries = 0;              // support() calls (TiltedPiece, SectionScratch)
   Vec3 support(const Vec3& d) const noexcept {
     ++queries;
+    if (core > 0.0) return core_support(d);
     if (cap_r > 0.0) {
       auto along = [&](const P3& v) { return v.x * d.x + v.y * d.y + v.z * d.z; };
       int best = 0;
@@ -184,7 +194,7 @@ struct Hull3 {
   // The same with the in-plane direction given as (ux, uy) = (cos φ, sin φ).
   P2 section_point(double ux, double uy, double zc, double eps, double& t_lo, double& t_hi,
                    int min_steps) const noexcept {
-    if (cap_r > 0.0) return capsule_point(ux, uy, zc);
+    if (cap_r > 0.0 && core == 0.0) return capsule_point(ux, uy, zc);
     // Every query also bounds the section's support value h_S(u) from above: any point x of
     // the section (x.z = zc) has u·x + t·zc <= h_H(u, t), so h_S(u) <= g(t) = u·s + t·(s.z −
     // zc) with s the support point of (u, t).
@@ -258,6 +268,27 @@ struct Hull3 {
     return last;
   }
   P2 capsule_point(double ux, double uy, double zc) const noexcept;
+  // The rounded core model's support point in direction d: the best of the four core disks'
+  // (a disk of radius ρ about c normal to a: c + ρ·d⊥/|d⊥|), moved out by cap_r along d.
+  Vec3 core_support(const Vec3& d) const noexcept {
+    double best = -INFINITY;
+    Vec3 bp{};
+    for (int k = 0; k < 2; ++k) {
+      const Vec3& a = pose[k].axis;
+      const double along = dot(a, d);
+      const P3& c = q[2 * k + (along > 0.0 ? 1 : 0)];
+      const Vec3 perp = d - along * a;
+      const double pl = norm(perp);
+      const double v = c.x * d.x + c.y * d.y + c.z * d.z + core * pl;
+      if (v > best) {
+        best = v;
+        const double f = pl > 1e-15 ? core / pl : 0.0;
+        bp = Vec3{c.x + f * perp.x, c.y + f * perp.y, c.z + f * perp.z};
+      }
+    }
+    const double l = norm(d);
+    return l > 0.0 ? bp + (cap_r / l) * d : bp;
+  }
 
  private:
   // Q's edges near the plane of the last capsule query: p0 + s·(dx, dy, dz), s in [s0, s1]
@@ -807,7 +838,8 @@ const std::array<SectionScratch::P2, TiltedPiece::kDirs>& coarse_directions() no
 // Between the support points a and b of directions φa < φb the boundary lies in the
 // triangle of the chord ab and the two support lines (convexity), whose height over the
 // chord is at most |ab|/2 · tan((φb − φa)/2) (base angles summing to φb − φa). An interval
-// is split at its middle direction until that bound is within tol/2, so every vertex is
+// is split at its middle direction until that bound is within tol less the point accuracy
+// (the tolerance's one-sided bound for tilted sections), so every vertex is
 // evaluated once and kept; a middle point on the chord (within the point accuracy) proves
 // the boundary straight there (the support line through it holds a and b) and ends the
 // split as well. So does a triangle (support lines moved out by the point accuracy) that
@@ -819,10 +851,11 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
   constexpr int kMaxPoints = 8192;
   constexpr int kWarmSteps = 1;  // a middle direction starts from its neighbours' brackets
   const double eps = kPointEps * tol;
+  // The chord may leave out up to tol of the section, less the points' own accuracy.
+  const double max_gap2 = (tol - eps) * (tol - eps);
   const double zc = p.zc;
   struct Iv {
-    double pa, pb;
-    P2 ua, ub;  // (cos, sin) of pa and pb
+    P2 ua, ub;  // the directions of a and b
     P2 a, b;
     double ta_lo, ta_hi, tb_lo, tb_hi;
     int depth;
@@ -856,19 +889,16 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
     const auto& dj = p.dirs[j];
     Iv stack[64];
     int sp = 0;
-    const double pb = di.phi + 2.0 * std::numbers::pi / kStart;
-    stack[sp++] = {di.phi, pb, coarse_directions()[static_cast<std::size_t>(i)], coarse_directions()[static_cast<std::size_t>(j)], di.p, dj.p, di.t_lo,
-                   di.t_hi, dj.t_lo, dj.t_hi, 0};
+    stack[sp++] = {di.u, dj.u, di.p, dj.p, di.t_lo, di.t_hi, dj.t_lo, dj.t_hi, 0};
     while (sp > 0) {
       const Iv iv = stack[--sp];
       const double dx = iv.b.x - iv.a.x, dy = iv.b.y - iv.a.y;
       const double bound = 0.5 * tan_half[static_cast<std::size_t>(std::min(iv.depth, kDepths - 1))];  // |ab|/2 · tan(Δφ/2) / |ab|
       if (iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
-          bound * bound * (dx * dx + dy * dy) <= 0.25 * tol * tol || covered(iv)) {
+          bound * bound * (dx * dx + dy * dy) <= max_gap2 || covered(iv)) {
         sc.pts.push_back(iv.a);
         continue;
       }
-      const double pm = 0.5 * (iv.pa + iv.pb);
       const double ca = 0.5 * (iv.ta_lo + iv.ta_hi), cb = 0.5 * (iv.tb_lo + iv.tb_hi);
       const double hw = std::max(0.125 * std::abs(ca - cb), 0.5 * std::max(iv.ta_hi - iv.ta_lo, iv.tb_hi - iv.tb_lo));
       double mlo = 0.5 * (ca + cb) - hw, mhi = 0.5 * (ca + cb) + hw;
@@ -882,8 +912,8 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
         sc.pts.push_back(m);
         continue;
       }
-      stack[sp++] = {pm, iv.pb, um, iv.ub, m, iv.b, mlo, mhi, iv.tb_lo, iv.tb_hi, iv.depth + 1};  // right half last
-      stack[sp++] = {iv.pa, pm, iv.ua, um, iv.a, m, iv.ta_lo, iv.ta_hi, mlo, mhi, iv.depth + 1};
+      stack[sp++] = {um, iv.ub, m, iv.b, mlo, mhi, iv.tb_lo, iv.tb_hi, iv.depth + 1};  // right half last
+      stack[sp++] = {iv.ua, um, iv.a, m, iv.ta_lo, iv.ta_hi, mlo, mhi, iv.depth + 1};
     }
   }
 }
@@ -931,7 +961,6 @@ void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, cons
   const double eps = kPointEps * tol;
   double tlo = -1.0, thi = 1.0;
   for (int i = 0; i < n; ++i) {
-    const double phi = 2.0 * std::numbers::pi * i / n;
     int min_steps = 4;
     if (prev != nullptr) {
       tlo = prev->dirs[i].t_lo;
@@ -946,7 +975,7 @@ void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, cons
     }
     const P2 u = coarse_directions()[static_cast<std::size_t>(i)];
     const P2 q = hull.section_point(u.x, u.y, p.zc, eps, tlo, thi, min_steps);
-    p.dirs[i] = {phi, q, tlo, thi};
+    p.dirs[i] = {u, q, tlo, thi};
   }
   p.edge_count = 0;
   p.x0 = p.x1 = p.dirs[0].p.x;

@@ -11,7 +11,9 @@
 // the only error is polygonisation. Moves whose axis changes are subdivided so that no
 // point of the tool leaves the chord tolerance of the linear interpolation between
 // sub-steps. A tilted ball end mill (CutterShape::capsule_radius_mm) is taken as its exact
-// capsule instead of the profile polyline; its section points have a closed form.
+// capsule instead of the profile polyline; its section points have a closed form. A tilted
+// bull-nose mill (CutterShape::core_radius_mm) is taken as its exact torus and cylinder the
+// same way (a disk swept along the axis, grown by the corner radius).
 #pragma once
 
 #include <cstdint>
@@ -53,11 +55,10 @@ struct SectionScratch {
   std::vector<int> env;        // upper envelope of the disks' support lines (indices)
   std::vector<double> breaks;  // where env[i] takes over from env[i-1]
   struct Dir {
-    double phi;
-    P2 p;
-    double t_lo, t_hi;  // the bracket of the 3D direction's tilt that found p (section_general)
+    P2 u;  // the in-plane direction (cos φ, sin φ)
+    P2 p;  // the section's boundary point in direction u
+    double t_lo, t_hi;  // the bracket of the 3D direction's tilt that found p
   };
-  std::vector<Dir> dirs;
   std::vector<TiltedPiece> pieces;  // a tilted sweep's sub-steps on the plane (section())
   // Support queries of the tilted sections' refinement (Sweep::build_piece()) so far; the
   // coarse points' are in TiltedPiece::coarse_queries. A count for tests and profiles.
