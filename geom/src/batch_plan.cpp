@@ -33,16 +33,28 @@ double dist_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) noexcept {
   return norm(p - (a + t * ab));
 }
 
+// The farthest point from the tip [mm] of the part of `shape`'s cutting part that lies at
+// or below z_top at pose p (with 1 mm to spare): a point at height h on the axis and within
+// the tool's radius R of it lies no lower than tip.z + h·a.z − R·sqrt(1 − a.z²).
+double reach_below(const CutterShape& shape, const Pose& p, double z_top) noexcept {
+  const double R = shape.radius(), H = shape.height();
+  const double az = p.axis.z / norm(p.axis);
+  double h = H;
+  if (az > 0.0) h = std::clamp((z_top + 1.0 - p.tip.z + R * std::sqrt(std::max(0.0, 1.0 - az * az))) / az, 0.0, H);
+  return std::hypot(h, R);
+}
+
 // A run of milling sweeps from batch[i] whose tool axis turns (a sampled 5-axis stream):
 // extended while the next sweep continues the run with the same tool and every pose inside
 // the run (the ends of its sweeps) stays within tol of the merged sweep by
-// geom::pose_deviation_mm with the tool's reach (its profile's farthest point from the tip):
-// the rule of the live stream (motion::SampleStream). O(run) per sweep, so runs stop at
-// kMaxTiltedRun. Returns the end of the run; `merged` is its sweep.
-std::size_t merge_tilted_run(std::span<const SweepRef> batch, std::size_t i, double tol, SweepRef& merged) noexcept {
+// geom::pose_deviation_mm with the reach of the tool's part below z_top at that pose
+// (reach_below(): the rest of the tool cuts nothing, wherever it moves). The live stream's
+// rule (motion::SampleStream) is the same with the whole tool's reach. O(run) per sweep, so
+// runs stop at kMaxTiltedRun. Returns the end of the run; `merged` is its sweep.
+std::size_t merge_tilted_run(std::span<const SweepRef> batch, std::size_t i, double tol, double z_top,
+                             SweepRef& merged) noexcept {
   constexpr std::size_t kMaxTiltedRun = 64;
   const SweepRef& first = batch[i];
-  const double reach = std::hypot(first.shape->height(), first.shape->radius());
   merged = first;
   std::size_t j = i + 1;
   for (; j < batch.size() && j - i < kMaxTiltedRun; ++j) {
@@ -51,7 +63,10 @@ std::size_t merge_tilted_run(std::span<const SweepRef> batch, std::size_t i, dou
         !same_axis(n.from.axis, merged.to.axis))
       break;
     bool within = true;
-    for (std::size_t k = i; within && k < j; ++k) within = pose_deviation_mm(first.from, n.to, batch[k].to, reach) <= tol;
+    for (std::size_t k = i; within && k < j; ++k) {
+      const Pose& p = batch[k].to;
+      within = pose_deviation_mm(first.from, n.to, p, reach_below(*first.shape, p, z_top)) <= tol;
+    }
     if (!within) break;
     merged.to = n.to;
     merged.id = std::max(merged.id, n.id);
@@ -61,7 +76,7 @@ std::size_t merge_tilted_run(std::span<const SweepRef> batch, std::size_t i, dou
 
 }  // namespace
 
-void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out) {
+void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out, double z_top_mm) {
   out.clear();
   constexpr std::size_t kMaxRun = 512;
   std::size_t i = 0;
@@ -74,7 +89,7 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
     SweepRef merged = first;
     const double tol = 0.5 * (first.shape != nullptr ? first.shape->chord_tol_mm : first.turning->chord_tol_mm);
     if (first.shape != nullptr && !same_axis(first.from.axis, first.to.axis)) {
-      i = merge_tilted_run(batch, i, tol, merged);
+      i = merge_tilted_run(batch, i, tol, z_top_mm, merged);
       out.push_back(merged);
       continue;
     }
@@ -209,7 +224,7 @@ int interval_of(const std::vector<Coord>& b, Coord v) noexcept {
 }
 
 void SubtractEngine::prepare(std::span<const SweepRef> batch, SubtractShared& sh) const {
-  merge_collinear(batch, sh.merged);
+  merge_collinear(batch, sh.merged, s_.z_top_mm());
   double zlo = INFINITY, zhi = -INFINITY;
   plan_moves(sh, zlo, zhi);
   const bool nothing =

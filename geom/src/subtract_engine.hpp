@@ -92,8 +92,10 @@ class SubtractEngine {
 // swept region moves by at most that much). The merged move keeps the largest move id.
 // Sampled straight lines collapse to one move each. Runs whose tool axis turns merge while
 // every pose inside stays within that of the merged move, rotation times the tool's reach
-// included (geom::pose_deviation_mm). Allocates only when `out` grows.
-void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out);
+// included (geom::pose_deviation_mm); the reach counts only the part of the tool that comes
+// below `z_top_mm` (the solid's top: nothing above it can be cut). Allocates only when
+// `out` grows.
+void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out, double z_top_mm = INFINITY);
 
 // Builds offset `o` of the prepared batch (sh.offsets[o].paths) unless it is built; waits
 // while another thread builds it. Allocates (Clipper).

@@ -34,9 +34,45 @@ double cross2(const P2& o, const P2& a, const P2& b) noexcept {
   return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
 }
 
-// Andrew's monotone chain; counter-clockwise, collinear points dropped. Sorts `pts`.
+// True when `pts` is already a strictly convex counter-clockwise polygon: every turn is a
+// left turn and x changes direction twice (once round: a polygon of left turns that winds
+// more than once changes it more often). The support points of a tilted section, in the
+// order of their directions, nearly always are.
+bool convex_in_order(const std::vector<P2>& pts) noexcept {
+  const std::size_t n = pts.size();
+  if (n < 3) return false;
+  int turns = 0;
+  double last_dx = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const P2& a = pts[i];
+    const P2& b = pts[i + 1 < n ? i + 1 : i + 1 - n];
+    const P2& c = pts[i + 2 < n ? i + 2 : i + 2 - n];
+    if (!(cross2(a, b, c) > 0.0)) return false;
+    const double dx = b.x - a.x;
+    if (dx != 0.0) {
+      if (last_dx != 0.0 && (dx > 0.0) != (last_dx > 0.0)) ++turns;
+      last_dx = dx;
+    }
+  }
+  // The wrap from the last edge with dx != 0 to the first.
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = pts[i + 1 < n ? i + 1 : 0].x - pts[i].x;
+    if (dx != 0.0) {
+      if ((dx > 0.0) != (last_dx > 0.0)) ++turns;
+      break;
+    }
+  }
+  return turns == 2;
+}
+
+// Andrew's monotone chain; counter-clockwise, collinear points dropped. Sorts `pts` unless
+// they already are a strictly convex counter-clockwise polygon (then copied as they are).
 void convex_hull(std::vector<P2>& pts, std::vector<P2>& hull) {
   hull.clear();
+  if (convex_in_order(pts)) {
+    hull.assign(pts.begin(), pts.end());
+    return;
+  }
   std::sort(pts.begin(), pts.end(), [](const P2& a, const P2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   const std::size_t n = pts.size();
   if (n < 3) {
@@ -938,7 +974,7 @@ bool beside_material(const Hull3& hull, const Circle* c, int n, const Rect& m) n
   }
   const double mx0 = to_mm(m.x0), mx1 = to_mm(m.x1), my0 = to_mm(m.y0), my1 = to_mm(m.y1);
   if (x1 < mx0 || x0 > mx1 || y1 < my0 || y0 > my1) return true;
-  const double ux = cx - 0.5 * (mx0 + mx1), uy = cy - 0.5 * (my0 + my1), ul = std::hypot(ux, uy);
+  const double ux = cx - 0.5 * (mx0 + mx1), uy = cy - 0.5 * (my0 + my1), ul = std::sqrt(ux * ux + uy * uy);
   if (!(ul > 0.0)) return false;
   const Vec3 u{ux / ul, uy / ul, 0.0};
   const double hull_min = dot(hull.support(Vec3{-u.x, -u.y, 0.0}), u);
@@ -986,7 +1022,7 @@ void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, cons
     p.x1 = std::max(p.x1, a.x);
     p.y0 = std::min(p.y0, a.y);
     p.y1 = std::max(p.y1, a.y);
-    const double ex = b.x - a.x, ey = b.y - a.y, l = std::hypot(ex, ey);
+    const double ex = b.x - a.x, ey = b.y - a.y, l = std::sqrt(ex * ex + ey * ey);  // mm: not the slower hypot
     if (!(l > 1e-9)) continue;  // coinciding points: no edge
     const double nx = ey / l, ny = -ex / l;  // outward for a counter-clockwise polygon
     p.edges[p.edge_count++] = {nx, ny, nx * a.x + ny * a.y};
