@@ -114,6 +114,27 @@ std::size_t tail_start(Fn f, Fn g) noexcept {
   return static_cast<std::size_t>(it - f.begin()) - 1;
 }
 
+// The part of chain c from the last x at or before which c lies nowhere above the previous
+// polygon's chain p (c itself when it begins before p or above it), written to `buf` when it
+// starts between two of c's vertices. The envelope is no lower than p on p's domain, so
+// max(envelope, c) is the envelope up to there.
+Fn beyond_previous(Fn c, Fn p, std::vector<P>& buf) {
+  if (c.front().x < p.front().x || c.front().x > p.back().x) return c;
+  double start = c.front().x;
+  walk(c, p, [&](double x, double cv, double pv, bool, bool) {
+    if (cv > pv) return false;
+    start = x;
+    return true;
+  });
+  if (start == c.front().x) return c;
+  const auto it = std::lower_bound(c.begin(), c.end(), start, [](const P& q, double x) { return q.x < x; });
+  const std::size_t i = static_cast<std::size_t>(it - c.begin());
+  if (c[i].x == start) return c.subspan(i);
+  buf.assign(1, P{start, value_at(c, i, start)});
+  buf.insert(buf.end(), c.begin() + static_cast<std::ptrdiff_t>(i), c.end());
+  return buf;
+}
+
 }  // namespace
 
 void MonotoneUnion::begin(double dx, double dy) noexcept {
@@ -195,11 +216,15 @@ bool MonotoneUnion::add(const Path& poly) {
   } else {
     // The envelopes' vertices from ku and kl on are those the polygon can change.
     const std::size_t ku = tail_start(up_, cu_), kl = tail_start(lo_, cl_);
-    if (!meets_union(ku, kl) || !merge_max(Fn(up_).subspan(ku), cu_, tmp_) || !merge_max(Fn(lo_).subspan(kl), cl_, tmp2_))
-      return false;
-    up_.resize(ku);
+    if (!meets_union(ku, kl)) return false;
+    // Where a chain lies under the previous polygon's, it lies under the envelope (which is
+    // no lower), so the merge starts where it first may not.
+    const Fn cu = beyond_previous(cu_, pu_, cut_u_), cl = beyond_previous(cl_, pl_, cut_l_);
+    const std::size_t mu = tail_start(up_, cu), ml = tail_start(lo_, cl);
+    if (!merge_max(Fn(up_).subspan(mu), cu, tmp_) || !merge_max(Fn(lo_).subspan(ml), cl, tmp2_)) return false;
+    up_.resize(mu);
     up_.insert(up_.end(), tmp_.begin(), tmp_.end());
-    lo_.resize(kl);
+    lo_.resize(ml);
     lo_.insert(lo_.end(), tmp2_.begin(), tmp2_.end());
   }
   ++count_;

@@ -48,6 +48,7 @@ class MonotoneUnion {
   std::vector<P> pu_, pl_;  // the same of the polygon added last
   std::vector<P> pts_;      // the polygon being added, in the frame
   std::vector<P> tmp_, tmp2_;  // the merges' output (upper, lower)
+  std::vector<P> cut_u_, cut_l_;  // a chain's part that can rise above the envelope, when cut between vertices
 };
 
 }  // namespace lbr::geom::detail

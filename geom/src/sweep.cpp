@@ -895,6 +895,7 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
     P2 a, b;
     double ta_lo, ta_hi, tb_lo, tb_hi;
     int depth;
+    int ma, mb;  // which covers hold a and b (bit 0: cover0, bit 1: cover1; −1: not known yet)
   };
   // tan(Δφ/2) of an interval at each depth (Δφ = 2π/kStart/2^depth); beyond the table, the
   // last entry bounds it.
@@ -905,19 +906,28 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
     return t;
   }();
   // The triangle of interval iv lies inside a cover (its three corners do; margin: the
-  // point accuracy and a kernel unit for the rounding of the cover's polygon).
+  // point accuracy and a kernel unit for the rounding of the cover's polygon). Which covers
+  // hold a point is found once per point: each end is shared by two intervals.
   const double margin = eps + 1.0 / kUnitsPerMm;
-  auto covered = [&](const Iv& iv) {
-    if (cover0 == nullptr && cover1 == nullptr) return false;
+  const bool any_cover = cover0 != nullptr || cover1 != nullptr;
+  auto mask_of = [&](const P2& q) {
+    return (cover0 != nullptr && cover0->covers(q, margin) ? 1 : 0) | (cover1 != nullptr && cover1->covers(q, margin) ? 2 : 0);
+  };
+  auto covered = [&](Iv& iv) {
+    if (!any_cover) return false;
+    if (iv.ma < 0) iv.ma = mask_of(iv.a);
+    if (iv.mb < 0) iv.mb = mask_of(iv.b);
+    const int both = iv.ma & iv.mb;
+    if (both == 0) return false;
     const double ax = iv.ua.x, ay = iv.ua.y, bx = iv.ub.x, by = iv.ub.y;
     const double ha = ax * iv.a.x + ay * iv.a.y + eps, hb = bx * iv.b.x + by * iv.b.y + eps;
     const double det = ax * by - ay * bx;  // sin(φb − φa) > 0
     if (!(det > 1e-12)) return false;
     const P2 apex{(ha * by - hb * ay) / det, (ax * hb - bx * ha) / det};
-    for (const TiltedPiece* c : {cover0, cover1})
-      if (c != nullptr && c->covers(apex, margin) && c->covers(iv.a, margin) && c->covers(iv.b, margin)) return true;
-    return false;
+    return ((both & 1) != 0 && cover0->covers(apex, margin)) || ((both & 2) != 0 && cover1->covers(apex, margin));
   };
+  int coarse_mask[kStart];
+  std::fill(std::begin(coarse_mask), std::end(coarse_mask), -1);
   sc.pts.clear();
   for (int i = 0; i < kStart; ++i) {
     const int j = (i + 1) % kStart;
@@ -925,13 +935,19 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
     const auto& dj = p.dirs[j];
     Iv stack[64];
     int sp = 0;
-    stack[sp++] = {di.u, dj.u, di.p, dj.p, di.t_lo, di.t_hi, dj.t_lo, dj.t_hi, 0};
+    stack[sp++] = {di.u, dj.u, di.p, dj.p, di.t_lo, di.t_hi, dj.t_lo, dj.t_hi, 0, coarse_mask[i], coarse_mask[j]};
     while (sp > 0) {
-      const Iv iv = stack[--sp];
+      Iv iv = stack[--sp];
       const double dx = iv.b.x - iv.a.x, dy = iv.b.y - iv.a.y;
       const double bound = 0.5 * tan_half[static_cast<std::size_t>(std::min(iv.depth, kDepths - 1))];  // |ab|/2 · tan(Δφ/2) / |ab|
-      if (iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
-          bound * bound * (dx * dx + dy * dy) <= max_gap2 || covered(iv)) {
+      const bool fine = iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
+                        bound * bound * (dx * dx + dy * dy) <= max_gap2;
+      const bool done = fine || covered(iv);
+      if (iv.depth == 0) {  // the coarse ends' covers, for the intervals beside
+        coarse_mask[i] = iv.ma;
+        coarse_mask[j] = iv.mb;
+      }
+      if (done) {
         sc.pts.push_back(iv.a);
         continue;
       }
@@ -948,8 +964,8 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
         sc.pts.push_back(m);
         continue;
       }
-      stack[sp++] = {um, iv.ub, m, iv.b, mlo, mhi, iv.tb_lo, iv.tb_hi, iv.depth + 1};  // right half last
-      stack[sp++] = {iv.ua, um, iv.a, m, iv.ta_lo, iv.ta_hi, mlo, mhi, iv.depth + 1};
+      stack[sp++] = {um, iv.ub, m, iv.b, mlo, mhi, iv.tb_lo, iv.tb_hi, iv.depth + 1, -1, iv.mb};  // right half last
+      stack[sp++] = {iv.ua, um, iv.a, m, iv.ta_lo, iv.ta_hi, mlo, mhi, iv.depth + 1, iv.ma, -1};
     }
   }
 }
