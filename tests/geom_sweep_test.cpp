@@ -337,7 +337,7 @@ TEST(Sweep, TiltedPiecesWithNeighbourCoversKeepTheUnionWithFewerVertices) {
   auto bull = test::tool(ToolKind::Bull, 10);
   bull.corner_radius_mm = 2.0;
   const auto shape = geom::CutterShape::build(bull, kTol);
-  ASSERT_DOUBLE_EQ(shape.core_radius_mm, 3.0);  // the rounded core model (Hull3)
+  ASSERT_EQ(shape.capsule_radius_mm, 0.0);
   auto pose = [](int i) {
     const double a = (1.0 * i) * test::kPi / 180.0;
     return test::at(0.5 * i, 0, 0, {0, -std::sin(a), std::cos(a)});
@@ -418,9 +418,7 @@ TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
   // A bull Ø10 R2 raster along X in 0.5 mm moves whose tilt follows A = 20° sin(πx/27),
   // cut by a plane through the corner (a ball's capsule model takes one query per point;
   // the figures below were measured on the ball Ø6 of finish5x's ball pass before it;
-  // this bull with its profile's stations: 5.1 queries per coarse point, 3.5 per output
-  // vertex; with its rounded core, whose tilt search meets no station staircase: 2.68 and
-  // 2.55). The coarse points of each piece
+  // this bull: 5.1 queries per coarse point, 3.5 per output vertex). The coarse points of each piece
   // start from the previous piece's bracket moved by its drift, the refined points from
   // their neighbours' brackets, and each search stops once its point is proven within
   // tol/20 of the boundary, each search bracketing from its middle first: measured 4.0
@@ -430,7 +428,7 @@ TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
   auto bull = test::tool(ToolKind::Bull, 10);
   bull.corner_radius_mm = 2.0;
   const auto shape = geom::CutterShape::build(bull, kTol);
-  ASSERT_DOUBLE_EQ(shape.core_radius_mm, 3.0);  // the rounded core model (Hull3)
+  ASSERT_EQ(shape.capsule_radius_mm, 0.0);
   auto pose = [](int i) {
     const double x = -13.5 + 0.5 * i, a = 20.0 * std::sin(test::kPi * x / 27.0) * test::kPi / 180.0;
     return test::at(x, 0, 0, {0, -std::sin(a), std::cos(a)});
@@ -457,8 +455,8 @@ TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
   const double per_vertex = static_cast<double>(coarse + sc.support_queries) / static_cast<double>(vertices);
   std::printf("pieces %zu, queries per coarse point %.2f, per vertex %.2f (%zu vertices)\n", pieces.size(), per_coarse,
               per_vertex, vertices);
-  EXPECT_LT(per_coarse, 3.2);
-  EXPECT_LT(per_vertex, 3.0);
+  EXPECT_LT(per_coarse, 5.6);
+  EXPECT_LT(per_vertex, 3.8);
 }
 
 namespace {
@@ -534,49 +532,6 @@ TEST(Sweep, TiltedBallSectionsMatchTheExactSliceOfTheCapsuleSweep) {
     EXPECT_LE(got, ref + perimeter * kHalfUnitMm) << z;  // rounding to the unit grid
     EXPECT_GE(got, ref - 0.25 * kTol * perimeter) << z;
   }
-}
-
-TEST(Sweep, TiltedBullSectionVerticesLieOnTheExactTorusAndCylinder) {
-  // A bull Ø10 R2 tilted 25° about X (CutterShape::core_radius_mm: the points within 2 mm of
-  // a disk of radius 3 swept along the axis from the corner's centre to the top of the
-  // flutes), cut through its flat end and torus (z 0.3, 1.0), the torus (1.9) and the
-  // cylinder (4, 10). Each vertex is a support point found to within tol/20 and rounded to
-  // the unit grid, so its distance to the exact surface (an independent formula: the
-  // distance to that disk-swept core, less 2 mm) lies in [−(tol/20 + ½ unit), ½ unit]. The
-  // station model (the corner arc as a polyline within ±tol) put them up to tol off.
-  auto bull = test::tool(ToolKind::Bull, 10);
-  bull.corner_radius_mm = 2.0;
-  const auto shape = geom::CutterShape::build(bull, kTol);
-  ASSERT_DOUBLE_EQ(shape.capsule_radius_mm, 2.0);
-  ASSERT_DOUBLE_EQ(shape.core_radius_mm, 3.0);
-  const double a = 25.0 * test::kPi / 180.0;
-  const geom::Vec3 ax{0, -std::sin(a), std::cos(a)};
-  const geom::Pose pose = test::at(0, 0, 0, ax);
-  const geom::Sweep s(shape, pose, pose);
-  auto surface_distance = [&](double x, double y, double z) {
-    const geom::Vec3 d = geom::Vec3{x, y, z} - pose.tip;
-    const double h = geom::dot(d, ax), radial = geom::norm(d - h * ax);
-    const double hc = std::clamp(h, 2.0, shape.height());
-    return std::hypot(h - hc, std::max(0.0, radial - 3.0)) - 2.0;
-  };
-  std::size_t torus_vertices = 0;
-  for (double z : {0.3, 1.0, 1.9, 4.0, 10.0}) {
-    geom::Paths out;
-    geom::SectionScratch sc;
-    ASSERT_EQ(s.section(z, out, sc), 1u) << z;
-    double inside_most = 0.0, outside_most = -1.0;
-    for (const geom::Point& p : out[0]) {
-      const double x = geom::to_mm(p.X), y = geom::to_mm(p.Y);
-      const double dist = surface_distance(x, y, z);
-      inside_most = std::min(inside_most, dist);
-      outside_most = std::max(outside_most, dist);
-      const geom::Vec3 q = geom::Vec3{x, y, z} - pose.tip;
-      if (geom::dot(q, ax) < 2.0 && geom::norm(q - geom::dot(q, ax) * ax) > 3.0) ++torus_vertices;
-    }
-    EXPECT_GE(inside_most, -(kTol / 20.0 + kHalfUnitMm + 1e-6)) << z << ": " << out[0].size() << " vertices";
-    EXPECT_LE(outside_most, kHalfUnitMm + 1e-6) << z;
-  }
-  EXPECT_GT(torus_vertices, 20u);
 }
 
 TEST(Sweep, ABallLyingInTheLevelPlaneIsAStadium) {

@@ -149,17 +149,9 @@ int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
 // only the cylinder's flat top becomes a hemisphere, which lies inside the shank above it.
 // The sub-step's hull is then Q ⊕ B(r), Q the tetrahedron of the two poses' segment ends,
 // and its section has a closed-form support point in every direction (capsule_point()).
-// A bull-nose mill (CutterShape::core_radius_mm) is taken the same way with a disk of radius
-// ρ (its flat end's) in place of each segment end: the points within its corner radius of
-// that disk swept along the axis from the corner's centre to the top of the flutes. The
-// sub-step's hull is then conv(four disks) ⊕ B(r), whose support is the best of the four
-// disks' plus r along the direction (core_support()): the profile's exact torus instead of
-// its polyline, and the tilt search's height z(t) is smooth but for the switches between the
-// four disks, not a staircase of station bands.
 struct Hull3 {
   Hull3(const CutterShape* s, const Pose& a, const Pose& b) noexcept : shape(s), pose{a, b} {
     cap_r = s->capsule_radius_mm;
-    core = s->core_radius_mm;
     if (cap_r <= 0.0) return;
     const double top = s->height();
     q[0] = p3(a.tip + cap_r * a.axis);
@@ -170,13 +162,11 @@ struct Hull3 {
   const CutterShape* shape;
   Pose pose[2];
   double cap_r = 0.0;  // > 0: the capsule model (q: the segment ends at both poses)
-  double core = 0.0;   // > 0 with cap_r: the rounded core model (q: the core disks' centres)
   P3 q[4];  // a.centre, a.top, b.centre, b.top (set only for the capsule: no initialisers)
   mutable std::size_t last_station[2] = {0, 0};  // each pose's best station of the last query
   mutable std::uint32_t queries = 0;              // support() calls (TiltedPiece, SectionScratch)
   Vec3 support(const Vec3& d) const noexcept {
     ++queries;
-    if (core > 0.0) return core_support(d);
     if (cap_r > 0.0) {
       auto along = [&](const P3& v) { return v.x * d.x + v.y * d.y + v.z * d.z; };
       int best = 0;
@@ -230,7 +220,7 @@ struct Hull3 {
   // The same with the in-plane direction given as (ux, uy) = (cos φ, sin φ).
   P2 section_point(double ux, double uy, double zc, double eps, double& t_lo, double& t_hi,
                    int min_steps) const noexcept {
-    if (cap_r > 0.0 && core == 0.0) return capsule_point(ux, uy, zc);
+    if (cap_r > 0.0) return capsule_point(ux, uy, zc);
     // Every query also bounds the section's support value h_S(u) from above: any point x of
     // the section (x.z = zc) has u·x + t·zc <= h_H(u, t), so h_S(u) <= g(t) = u·s + t·(s.z −
     // zc) with s the support point of (u, t).
@@ -304,28 +294,6 @@ struct Hull3 {
     return last;
   }
   P2 capsule_point(double ux, double uy, double zc) const noexcept;
-  // The rounded core model's support point in direction d: the best of the four core disks'
-  // (a disk of radius ρ about c normal to a: c + ρ·d⊥/|d⊥|), moved out by cap_r along d.
-  Vec3 core_support(const Vec3& d) const noexcept {
-    double best = -INFINITY;
-    Vec3 bp{};
-    for (int k = 0; k < 2; ++k) {
-      const Vec3& a = pose[k].axis;
-      const double along = dot(a, d);
-      const P3& c = q[2 * k + (along > 0.0 ? 1 : 0)];
-      const Vec3 perp = d - along * a;
-      const double pl = norm(perp);
-      const double v = c.x * d.x + c.y * d.y + c.z * d.z + core * pl;
-      if (v > best) {
-        best = v;
-        const double f = pl > 1e-15 ? core / pl : 0.0;
-        bp = Vec3{c.x + f * perp.x, c.y + f * perp.y, c.z + f * perp.z};
-      }
-    }
-    const double l = norm(d);
-    return l > 0.0 ? bp + (cap_r / l) * d : bp;
-  }
-
  private:
   // Q's edges near the plane of the last capsule query: p0 + s·(dx, dy, dz), s in [s0, s1]
   // within r of it; `level`: dz = 0 (the support is at s0 or s1).
