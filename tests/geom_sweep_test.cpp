@@ -418,7 +418,9 @@ TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
   // A bull Ø10 R2 raster along X in 0.5 mm moves whose tilt follows A = 20° sin(πx/27),
   // cut by a plane through the corner (a ball's capsule model takes one query per point;
   // the figures below were measured on the ball Ø6 of finish5x's ball pass before it;
-  // this bull: 5.1 queries per coarse point, 3.5 per output vertex). The coarse points of each piece
+  // this bull: 5.1 queries per coarse point, 3.5 per output vertex; 4.0 per vertex since
+  // chords are split only to the tolerance, with fewer vertices to share the coarse points'
+  // queries). The coarse points of each piece
   // start from the previous piece's bracket moved by its drift, the refined points from
   // their neighbours' brackets, and each search stops once its point is proven within
   // tol/20 of the boundary, each search bracketing from its middle first: measured 4.0
@@ -456,7 +458,7 @@ TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
   std::printf("pieces %zu, queries per coarse point %.2f, per vertex %.2f (%zu vertices)\n", pieces.size(), per_coarse,
               per_vertex, vertices);
   EXPECT_LT(per_coarse, 5.6);
-  EXPECT_LT(per_vertex, 3.8);
+  EXPECT_LT(per_vertex, 4.3);
 }
 
 namespace {
