@@ -55,6 +55,7 @@ std::size_t merge_tilted_run(std::span<const SweepRef> batch, std::size_t i, dou
                              SweepRef& merged) noexcept {
   constexpr std::size_t kMaxTiltedRun = 64;
   const SweepRef& first = batch[i];
+  double reach[kMaxTiltedRun];  // of each pose inside the run, found once
   merged = first;
   std::size_t j = i + 1;
   for (; j < batch.size() && j - i < kMaxTiltedRun; ++j) {
@@ -62,11 +63,9 @@ std::size_t merge_tilted_run(std::span<const SweepRef> batch, std::size_t i, dou
     if (n.shape != first.shape || n.turning != nullptr || !(n.from.tip == merged.to.tip) ||
         !same_axis(n.from.axis, merged.to.axis))
       break;
+    reach[j - 1 - i] = reach_below(*first.shape, batch[j - 1].to, z_top);  // the pose now inside
     bool within = true;
-    for (std::size_t k = i; within && k < j; ++k) {
-      const Pose& p = batch[k].to;
-      within = pose_deviation_mm(first.from, n.to, p, reach_below(*first.shape, p, z_top)) <= tol;
-    }
+    for (std::size_t k = i; within && k < j; ++k) within = pose_deviation_mm(first.from, n.to, batch[k].to, reach[k - i]) <= tol;
     if (!within) break;
     merged.to = n.to;
     merged.id = std::max(merged.id, n.id);

@@ -294,6 +294,7 @@ struct Hull3 {
     return last;
   }
   P2 capsule_point(double ux, double uy, double zc) const noexcept;
+
  private:
   // Q's edges near the plane of the last capsule query: p0 + s·(dx, dy, dz), s in [s0, s1]
   // within r of it; `level`: dz = 0 (the support is at s0 or s1).
