@@ -84,6 +84,9 @@ TEST(BundledProfiles, Mill5AC) {
   EXPECT_FALSE(p.kin.tcp);
   EXPECT_EQ(p.kin.pivot_length_mm, 0.0);
   EXPECT_EQ(p.solid.box.min.x, -30.0);
+  EXPECT_TRUE(p.live_grid.set);  // live runs on 3.75-mm cells (docs/performance.md)
+  EXPECT_EQ(p.live_grid.x, 16);
+  EXPECT_EQ(p.live_grid.y, 16);
   EXPECT_EQ(p.tooling.tools.at(2).diameter_mm, 16.0);
   const nc::GcodeOptions o = app::gcode_options(p);
   EXPECT_EQ(o.machine, nc::MachineKind::Mill5);

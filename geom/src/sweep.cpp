@@ -149,9 +149,17 @@ int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
 // only the cylinder's flat top becomes a hemisphere, which lies inside the shank above it.
 // The sub-step's hull is then Q ⊕ B(r), Q the tetrahedron of the two poses' segment ends,
 // and its section has a closed-form support point in every direction (capsule_point()).
+// A bull-nose mill (CutterShape::core_radius_mm) is taken the same way with a disk of radius
+// ρ (its flat end's) in place of each segment end: the points within its corner radius of
+// that disk swept along the axis from the corner's centre to the top of the flutes. The
+// sub-step's hull is then conv(four disks) ⊕ B(r), whose support is the best of the four
+// disks' plus r along the direction (core_support()): the profile's exact torus instead of
+// its polyline, and the tilt search's height z(t) is smooth but for the switches between the
+// four disks, not a staircase of station bands.
 struct Hull3 {
   Hull3(const CutterShape* s, const Pose& a, const Pose& b) noexcept : shape(s), pose{a, b} {
     cap_r = s->capsule_radius_mm;
+    core = s->core_radius_mm;
     if (cap_r <= 0.0) return;
     const double top = s->height();
     q[0] = p3(a.tip + cap_r * a.axis);
@@ -162,11 +170,13 @@ struct Hull3 {
   const CutterShape* shape;
   Pose pose[2];
   double cap_r = 0.0;  // > 0: the capsule model (q: the segment ends at both poses)
+  double core = 0.0;   // > 0 with cap_r: the rounded core model (q: the core disks' centres)
   P3 q[4];  // a.centre, a.top, b.centre, b.top (set only for the capsule: no initialisers)
   mutable std::size_t last_station[2] = {0, 0};  // each pose's best station of the last query
   mutable std::uint32_t queries = 0;              // support() calls (TiltedPiece, SectionScratch)
   Vec3 support(const Vec3& d) const noexcept {
     ++queries;
+    if (core > 0.0) return core_support(d);
     if (cap_r > 0.0) {
       auto along = [&](const P3& v) { return v.x * d.x + v.y * d.y + v.z * d.z; };
       int best = 0;
@@ -220,7 +230,7 @@ struct Hull3 {
   // The same with the in-plane direction given as (ux, uy) = (cos φ, sin φ).
   P2 section_point(double ux, double uy, double zc, double eps, double& t_lo, double& t_hi,
                    int min_steps) const noexcept {
-    if (cap_r > 0.0) return capsule_point(ux, uy, zc);
+    if (cap_r > 0.0 && core == 0.0) return capsule_point(ux, uy, zc);
     // Every query also bounds the section's support value h_S(u) from above: any point x of
     // the section (x.z = zc) has u·x + t·zc <= h_H(u, t), so h_S(u) <= g(t) = u·s + t·(s.z −
     // zc) with s the support point of (u, t).
@@ -235,7 +245,11 @@ struct Hull3 {
     // which is all that the refinement needs of it (refine_section()); then no further
     // step is taken whatever min_steps says.
     auto proven = [&](const P2& pt) { return upper - (ux * pt.x + uy * pt.y) <= eps; };
+    // A start bracket is a neighbour's result; one that is not finite (a search whose plane
+    // missed the hull widened it without end) starts afresh, or the queries would be NaN.
+    constexpr double kMaxTilt = 1e6;
     double tlo = t_lo, thi = t_hi;
+    if (!(std::abs(tlo) <= kMaxTilt && std::abs(thi) <= kMaxTilt && tlo < thi)) tlo = -1.0, thi = 1.0;
     // The middle first, then the end on the other side of the plane: the start bracket is
     // halved for the same two queries.
     Vec3 plo, phi_;
@@ -294,6 +308,44 @@ struct Hull3 {
     return last;
   }
   P2 capsule_point(double ux, double uy, double zc) const noexcept;
+  // Narrows [lo, hi] to the height range of the capsule's or rounded core's hull (exact);
+  // the station model's hull is what its circles span, so it leaves them. The stations'
+  // polyline lies up to the chord tolerance outside the exact profile, so their circles can
+  // reach below the exact model, and a plane between the two misses the hull: its search
+  // would find no point on it.
+  void clamp_z_extent(double& lo, double& hi) const noexcept {
+    if (cap_r <= 0.0) return;
+    double zl = INFINITY, zh = -INFINITY;
+    for (int i = 0; i < 4; ++i) {
+      const Vec3& a = pose[i / 2].axis;
+      const double e = core * std::sqrt(std::max(0.0, 1.0 - a.z * a.z));  // a core disk's half-height
+      zl = std::min(zl, q[i].z - e);
+      zh = std::max(zh, q[i].z + e);
+    }
+    lo = std::max(lo, zl - cap_r);
+    hi = std::min(hi, zh + cap_r);
+  }
+  // The rounded core model's support point in direction d: the best of the four core disks'
+  // (a disk of radius ρ about c normal to a: c + ρ·d⊥/|d⊥|), moved out by cap_r along d.
+  Vec3 core_support(const Vec3& d) const noexcept {
+    double best = -INFINITY;
+    Vec3 bp{};
+    for (int k = 0; k < 2; ++k) {
+      const Vec3& a = pose[k].axis;
+      const double along = dot(a, d);
+      const P3& c = q[2 * k + (along > 0.0 ? 1 : 0)];
+      const Vec3 perp = d - along * a;
+      const double pl = norm(perp);
+      const double v = c.x * d.x + c.y * d.y + c.z * d.z + core * pl;
+      if (v > best) {
+        best = v;
+        const double f = pl > 1e-15 ? core / pl : 0.0;
+        bp = Vec3{c.x + f * perp.x, c.y + f * perp.y, c.z + f * perp.z};
+      }
+    }
+    const double l = norm(d);
+    return l > 0.0 ? bp + (cap_r / l) * d : bp;
+  }
 
  private:
   // Q's edges near the plane of the last capsule query: p0 + s·(dx, dy, dz), s in [s0, s1]
@@ -1066,8 +1118,9 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
       zlo = std::min(zlo, circles[i].c.z - e);
       zhi = std::max(zhi, circles[i].c.z + e);
     }
-    if (zc < zlo || zc > zhi) continue;
     const Hull3 hull(&s, pa, b);
+    hull.clamp_z_extent(zlo, zhi);
+    if (zc < zlo || zc > zhi) continue;
     if (material != nullptr && beside_material(hull, circles, nc, *material)) continue;
     const bool warm = !out.empty() && out.back().zc == zc;
     out.emplace_back();

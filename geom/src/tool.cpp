@@ -143,6 +143,10 @@ CutterShape CutterShape::build(const Tool& tool, double chord_tol_mm) {
   if (s.stations.back().h < top) s.stations.push_back({top, s.stations.back().r});
   const bool shank_covers = tool.shank_diameter_mm == 0.0 || tool.shank_diameter_mm >= tool.diameter_mm;
   if (tool.kind == ToolKind::Ball && top >= r && shank_covers) s.capsule_radius_mm = r;
+  if (tool.kind == ToolKind::Bull && top >= corner_radius(tool) && shank_covers) {
+    s.capsule_radius_mm = corner_radius(tool);
+    s.core_radius_mm = r - corner_radius(tool);
+  }
   return s;
 }
 

@@ -11,7 +11,9 @@
 // the only error is polygonisation. Moves whose axis changes are subdivided so that no
 // point of the tool leaves the chord tolerance of the linear interpolation between
 // sub-steps. A tilted ball end mill (CutterShape::capsule_radius_mm) is taken as its exact
-// capsule instead of the profile polyline; its section points have a closed form.
+// capsule instead of the profile polyline; its section points have a closed form. A tilted
+// bull-nose mill (CutterShape::core_radius_mm) is taken as its exact torus and cylinder the
+// same way (a disk swept along the axis, grown by the corner radius).
 #pragma once
 
 #include <cstdint>

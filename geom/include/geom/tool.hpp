@@ -63,6 +63,13 @@ struct CutterShape {
   // capsule around the axis from the ball's centre to the top of the flutes (exact but for
   // the flutes' flat top, which becomes a hemisphere inside the shank; geom/src/sweep.cpp).
   double capsule_radius_mm = 0.0;
+  // > 0 for a bull-nose mill whose flutes reach above its corner and whose shank is no
+  // thinner than the head: the radius of its flat end (diameter/2 − corner radius). Tilted
+  // sweeps then take the cutting part as the points within the corner radius
+  // (capsule_radius_mm) of a disk of this radius normal to the axis, swept along the axis
+  // from the corner's centre to the top of the flutes: the flat end, the torus and the
+  // flutes' cylinder exactly, the flutes' top rounded inside the shank.
+  double core_radius_mm = 0.0;
 
   static CutterShape build(const Tool& tool, double chord_tol_mm);
   [[nodiscard]] double radius() const noexcept { return 0.5 * tool.diameter_mm; }
