@@ -536,6 +536,20 @@ TEST(Sweep, TiltedBallSectionsMatchTheExactSliceOfTheCapsuleSweep) {
   }
 }
 
+namespace {
+
+// Signed distance [mm] from p to a bull's rounded core: the points within r of a disk of
+// radius rho normal to `axis`, centred on base + h·axis for h in [h0, h1] (an independent
+// formula for the exact torus and cylinder; negative inside).
+double rounded_core_distance(const geom::Vec3& p, const geom::Vec3& base, const geom::Vec3& axis, double h0, double h1,
+                             double rho, double r) {
+  const geom::Vec3 d = p - base;
+  const double h = geom::dot(d, axis), radial = geom::norm(d - h * axis);
+  return std::hypot(h - std::clamp(h, h0, h1), std::max(0.0, radial - rho)) - r;
+}
+
+}  // namespace
+
 TEST(Sweep, TiltedBullSectionVerticesLieOnTheExactTorusAndCylinder) {
   // A bull Ø10 R2 tilted 25° about X (CutterShape::core_radius_mm: the points within 2 mm of
   // a disk of radius 3 swept along the axis from the corner's centre to the top of the
@@ -554,10 +568,7 @@ TEST(Sweep, TiltedBullSectionVerticesLieOnTheExactTorusAndCylinder) {
   const geom::Pose pose = test::at(0, 0, 0, ax);
   const geom::Sweep s(shape, pose, pose);
   auto surface_distance = [&](double x, double y, double z) {
-    const geom::Vec3 d = geom::Vec3{x, y, z} - pose.tip;
-    const double h = geom::dot(d, ax), radial = geom::norm(d - h * ax);
-    const double hc = std::clamp(h, 2.0, shape.height());
-    return std::hypot(h - hc, std::max(0.0, radial - 3.0)) - 2.0;
+    return rounded_core_distance({x, y, z}, pose.tip, ax, 2.0, shape.height(), 3.0, 2.0);
   };
   std::size_t torus_vertices = 0;
   for (double z : {0.3, 1.0, 1.9, 4.0, 10.0}) {
@@ -595,15 +606,11 @@ TEST(Sweep, TiltedBullSectionsNearItsLowestPointStayOnTheTool) {
   const geom::Pose lo = test::at(-20, -18.299183087152976, -8.1994956768430285, ax);
   const geom::Pose hi = test::at(-20, -18.367587115818107, -8.011557152685846, ax);
   const geom::Sweep s(shape, lo, hi);
-  const geom::Vec3 c0 = lo.tip + 2.0 * ax, c1 = hi.tip + shape.height() * ax;
-  const double len = geom::norm(c1 - c0);
-  auto outside = [&](double x, double y, double z) {  // distance outside the rounded core
-    const geom::Vec3 d = geom::Vec3{x, y, z} - c0;
-    const double h = geom::dot(d, ax), radial = geom::norm(d - h * ax);
-    const double axial = h < 0.0 ? -h : std::max(0.0, h - len);
-    return std::hypot(axial, std::max(0.0, radial - 3.0)) - 2.0;
+  const double top = geom::dot(hi.tip - lo.tip, ax) + shape.height();  // the upper flutes' top above lo's tip
+  auto outside = [&](double x, double y, double z) {
+    return rounded_core_distance({x, y, z}, lo.tip, ax, 2.0, top, 3.0, 2.0);
   };
-  const double lowest = c0.z - 3.0 * std::sqrt(1.0 - ax.z * ax.z) - 2.0;
+  const double lowest = lo.tip.z + 2.0 * ax.z - 3.0 * std::sqrt(1.0 - ax.z * ax.z) - 2.0;
   int planes_with_polygons = 0;
   double worst = -1.0;
   for (int k = -50; k <= 50; ++k) {
