@@ -297,16 +297,18 @@ TEST(Joined, TiltedRasterCutInOneBatchEqualsTheMovesCutOneByOne) {
 }
 
 TEST(Joined, TiltedSweepBesideTheMaterialBuildsNoSection) {
-  // A radial Ø30 face mill swung a quarter turn about the axis of a Ø40 bar with its face
+  // A radial Ø10 face mill swung a quarter turn about the axis of a Ø40 bar with its face
   // on radius 30 (a lathe-c rotary rapid): never in the material, though its box meets the
   // bar's box near 45°. No section is built and nothing is removed; the same swing with
-  // the face on radius 12 cuts.
+  // the face on radius 12 cuts. At the milling profiles' 10 µm: a face turning about an
+  // axis in its plane needs a sub-step per 4·tol/ρ of turn (its hull's excess, ρφ/2).
+  const double tol = 0.01;
   geom::SolidSpec spec;
   spec.shape = geom::SolidSpec::Shape::Cylinder;
   spec.cylinder = {0.0, 0.0, 40.0, -60.0, 0.0};
   spec.level_spacing_mm = 0.1;
   spec.regions_x = spec.regions_y = 2;
-  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 30, 0, 10), kTol);
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 10, 0, 10), tol);
   auto swing = [&](geom::LbrSolid& s, double radius) {
     std::vector<geom::SweepRef> m;  // 16 chords of the arc, as the kinematics splits a C move
     for (int k = 0; k < 16; ++k) {

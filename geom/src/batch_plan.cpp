@@ -34,14 +34,9 @@ double dist_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) noexcept {
 }
 
 // The farthest point from the tip [mm] of the part of `shape`'s cutting part that lies at
-// or below z_top at pose p (with 1 mm to spare): a point at height h on the axis and within
-// the tool's radius R of it lies no lower than tip.z + h·a.z − R·sqrt(1 − a.z²).
+// or below z_top at pose p (with 1 mm to spare; geom::cut_height_below()).
 double reach_below(const CutterShape& shape, const Pose& p, double z_top) noexcept {
-  const double R = shape.radius(), H = shape.height();
-  const double az = p.axis.z / norm(p.axis);
-  double h = H;
-  if (az > 0.0) h = std::clamp((z_top + 1.0 - p.tip.z + R * std::sqrt(std::max(0.0, 1.0 - az * az))) / az, 0.0, H);
-  return std::hypot(h, R);
+  return std::hypot(cut_height_below(shape, p, z_top + 1.0), shape.radius());
 }
 
 // A run of milling sweeps from batch[i] whose tool axis turns (a sampled 5-axis stream):
@@ -175,8 +170,8 @@ bool plan_chain(SubtractShared& sh, std::size_t& i, double& zlo, double& zhi) {
 }
 
 // The sweeps, runs, chains and turning sweeps of sh.merged; widens [zlo, zhi] to the
-// heights they reach.
-void plan_moves(SubtractShared& sh, double& zlo, double& zhi) {
+// heights they reach. `z_top` is the solid's top (geom::Sweep's z_top_mm).
+void plan_moves(SubtractShared& sh, double z_top, double& zlo, double& zhi) {
   sh.sweeps.clear();
   sh.sweep_id.clear();
   sh.runs.clear();
@@ -199,7 +194,7 @@ void plan_moves(SubtractShared& sh, double& zlo, double& zhi) {
       run_open = false;
       continue;
     }
-    sh.sweeps.emplace_back(*s.shape, s.from, s.to);
+    sh.sweeps.emplace_back(*s.shape, s.from, s.to, z_top);
     sh.sweep_id.push_back(s.id);
     const auto si = static_cast<std::uint32_t>(sh.sweeps.size() - 1);
     // A run: consecutive sweeps of one tool, each starting where the last ended (vertical
@@ -225,7 +220,7 @@ int interval_of(const std::vector<Coord>& b, Coord v) noexcept {
 void SubtractEngine::prepare(std::span<const SweepRef> batch, SubtractShared& sh) const {
   merge_collinear(batch, sh.merged, s_.z_top_mm());
   double zlo = INFINITY, zhi = -INFINITY;
-  plan_moves(sh, zlo, zhi);
+  plan_moves(sh, s_.z_top_mm(), zlo, zhi);
   const bool nothing =
       (sh.sweeps.empty() && sh.lathe.empty() && sh.chain_count == 0) || zhi < s_.z0_ || zlo > s_.z1_;
   sh.lb = nothing ? 0 : s_.level_at(zlo);

@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <cstdlib>
 
 namespace lbr::geom {
 
@@ -126,12 +127,19 @@ struct Circle {
   double r;
 };
 
-// Station circles of the tool at pose p, written to `out` (fixed capacity caller-side).
-int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
-  int n = 0;
+// Station circles of the tool's part up to axial height `top` at pose p: the stations
+// below it and one at `top` itself, written to `out` (fixed capacity caller-side).
+template <class F>
+void for_each_station_circle(const CutterShape& s, const Pose& p, double top, F&& f) noexcept {
   for (const auto& st : s.stations) {
-    out[n++] = Circle{p3(p.tip + st.h * p.axis), p3(p.axis), st.r};
+    if (st.h >= top) break;
+    f(Circle{p3(p.tip + st.h * p.axis), p3(p.axis), st.r});
   }
+  f(Circle{p3(p.tip + top * p.axis), p3(p.axis), s.radius_at(top)});
+}
+int station_circles(const CutterShape& s, const Pose& p, double top, Circle* out) noexcept {
+  int n = 0;
+  for_each_station_circle(s, p, top, [&](const Circle& c) { out[n++] = c; });
   return n;
 }
 
@@ -147,8 +155,10 @@ int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
 // is taken as a capsule instead: the points within its radius r of the axis segment from the
 // ball's centre to the top of the flutes. That is the ball and the flutes' cylinder exactly;
 // only the cylinder's flat top becomes a hemisphere, which lies inside the shank above it.
-// The sub-step's hull is then Q ⊕ B(r), Q the tetrahedron of the two poses' segment ends,
-// and its section has a closed-form support point in every direction (capsule_point()).
+// The sub-step is then K ⊕ B(r), K four of the edges of the tetrahedron of the two poses'
+// segment ends (each pose's segment and the paths of its ends: the tetrahedron's diagonals
+// stand out of the swept segment to first order in the turn), and its section has a
+// closed-form support point in every direction (capsule_point()).
 // A bull-nose mill (CutterShape::core_radius_mm) is taken the same way with a disk of radius
 // ρ (its flat end's) in place of each segment end: the points within its corner radius of
 // that disk swept along the axis from the corner's centre to the top of the flutes. The
@@ -156,21 +166,32 @@ int station_circles(const CutterShape& s, const Pose& p, Circle* out) noexcept {
 // disks' plus r along the direction (core_support()): the profile's exact torus instead of
 // its polyline, and the tilt search's height z(t) is smooth but for the switches between the
 // four disks, not a staircase of station bands.
+//
+// Only the tool's part up to axial height `top` (Sweep's top_: what lies above cuts
+// nothing) is modelled: the capsule's and the core's segments end there, and the station
+// model ends at a station of its own there (stations above it dropped).
 struct Hull3 {
-  Hull3(const CutterShape* s, const Pose& a, const Pose& b) noexcept : shape(s), pose{a, b} {
+  Hull3(const CutterShape* s, const Pose& a, const Pose& b, double top_mm) noexcept
+      : shape(s), pose{a, b}, top(top_mm) {
     cap_r = s->capsule_radius_mm;
     core = s->core_radius_mm;
-    if (cap_r <= 0.0) return;
-    const double top = s->height();
-    q[0] = p3(a.tip + cap_r * a.axis);
-    q[1] = p3(a.tip + top * a.axis);
-    q[2] = p3(b.tip + cap_r * b.axis);
-    q[3] = p3(b.tip + top * b.axis);
+    if (cap_r > 0.0) {
+      q[0] = p3(a.tip + cap_r * a.axis);
+      q[1] = p3(a.tip + top * a.axis);
+      q[2] = p3(b.tip + cap_r * b.axis);
+      q[3] = p3(b.tip + top * b.axis);
+      return;
+    }
+    while (low_stations < s->stations.size() && s->stations[low_stations].h < top) ++low_stations;
+    top_r = s->radius_at(top);
   }
   const CutterShape* shape;
   Pose pose[2];
+  double top;          // the modelled part's top [mm above the tip]
   double cap_r = 0.0;  // > 0: the capsule model (q: the segment ends at both poses)
   double core = 0.0;   // > 0 with cap_r: the rounded core model (q: the core disks' centres)
+  std::size_t low_stations = 0;  // station model: the stations below `top` (then one at top)
+  double top_r = 0.0;            // station model: the profile's radius at `top`
   P3 q[4];  // a.centre, a.top, b.centre, b.top (set only for the capsule: no initialisers)
   mutable std::size_t last_station[2] = {0, 0};  // each pose's best station of the last query
   mutable std::uint32_t queries = 0;              // support() calls (TiltedPiece, SectionScratch)
@@ -186,7 +207,13 @@ struct Hull3 {
       const Vec3 c{q[best].x, q[best].y, q[best].z};
       return l > 0.0 ? c + (cap_r / l) * d : c;
     }
-    const auto& st = shape->stations;
+    return station_support(d);
+  }
+  // The station model's support point: the stations below `top` and one at `top`.
+  Vec3 station_support(const Vec3& d) const noexcept {
+    const auto& stations = shape->stations;
+    const std::size_t ns = low_stations + 1;
+    auto st = [&](std::size_t i) { return i < low_stations ? stations[i] : CutterShape::Station{top, top_r}; };
     double best = -INFINITY;
     Vec3 bp{};
     const double dd = dot(d, d);
@@ -198,17 +225,19 @@ struct Hull3 {
       const bool flat = pl2 <= 1e-30 * dd;  // |d⊥| <= 1e-15 |d|
       const double pl = flat ? 0.0 : std::sqrt(pl2);
       auto rises = [&](std::size_t i) {
-        return (st[i + 1].h - st[i].h) * along + (flat ? 0.0 : (st[i + 1].r - st[i].r) * pl) > 0.0;
+        const CutterShape::Station a = st(i), b = st(i + 1);
+        return (b.h - a.h) * along + (flat ? 0.0 : (b.r - a.r) * pl) > 0.0;
       };
-      std::size_t lo = last_station[k];
-      while (lo + 1 < st.size() && rises(lo)) ++lo;
+      std::size_t lo = std::min(last_station[k], ns - 1);
+      while (lo + 1 < ns && rises(lo)) ++lo;
       while (lo > 0 && !rises(lo - 1)) --lo;
       last_station[k] = lo;
-      const double v = dot(p.tip, d) + st[lo].h * along + (flat ? 0.0 : st[lo].r * pl);
+      const CutterShape::Station best_st = st(lo);
+      const double v = dot(p.tip, d) + best_st.h * along + (flat ? 0.0 : best_st.r * pl);
       if (v > best) {
         best = v;
-        const Vec3 c = p.tip + st[lo].h * p.axis;
-        bp = flat || st[lo].r == 0.0 ? c : c + (st[lo].r / pl) * perp;
+        const Vec3 c = p.tip + best_st.h * p.axis;
+        bp = flat || best_st.r == 0.0 ? c : c + (best_st.r / pl) * perp;
       }
     }
     return bp;
@@ -348,7 +377,7 @@ struct Hull3 {
   }
 
  private:
-  // Q's edges near the plane of the last capsule query: p0 + s·(dx, dy, dz), s in [s0, s1]
+  // K's edges near the plane of the last capsule query: p0 + s·(dx, dy, dz), s in [s0, s1]
   // within r of it; `level`: dz = 0 (the support is at s0 or s1).
   struct CapEdge {
     P3 p0;
@@ -358,12 +387,12 @@ struct Hull3 {
   void prepare_capsule(double zc) const noexcept;
   mutable double cap_zc = NAN;
   mutable int cap_edges = 0;
-  mutable CapEdge cap_edge[6];
+  mutable CapEdge cap_edge[4];
 };
 
 // The capsule model's support point of the section on z = zc in direction u = (ux, uy):
-// the section of Q ⊕ B(r) is the hull of the sections of the balls swept along Q's six
-// edges (a slice of Q has its vertices on Q's edges), and along an edge p0 + s·d the
+// the hull of the sections of the balls swept along K's four edges (Hull3), and along an
+// edge p0 + s·d the
 // support value u·p(s) + sqrt(r² − (p(s).z − zc)²) is concave in s, greatest where its
 // derivative vanishes: p(s).z − zc = r·(u·d)·sgn(d.z) / sqrt(d.z² + (u·d)²), clamped to the
 // part of the edge within r of the plane. Exact up to rounding; one query.
@@ -389,7 +418,7 @@ P2 Hull3::capsule_point(double ux, double uy, double zc) const noexcept {
   return bp;
 }
 
-// The edges of Q that come within r of plane z = zc, each with the part of it that does.
+// The edges of K that come within r of plane z = zc, each with the part of it that does.
 void Hull3::prepare_capsule(double zc) const noexcept {
   cap_zc = zc;
   cap_edges = 0;
@@ -414,8 +443,6 @@ void Hull3::prepare_capsule(double zc) const noexcept {
   edge(q[2], q[3]);
   edge(q[0], q[2]);
   edge(q[1], q[3]);
-  edge(q[0], q[3]);
-  edge(q[1], q[2]);
 }
 
 double dist_to_line(const P2& p, const P2& a, const P2& b) noexcept {
@@ -450,7 +477,142 @@ int Sweep::circle_segments(double r_mm, double chord_tol_mm) noexcept {
   return std::min(n, 4096);
 }
 
-Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcept
+double cut_height_below(const CutterShape& shape, const Pose& p, double z_mm) noexcept {
+  const double R = shape.radius(), H = shape.height();
+  const double az = p.axis.z / norm(p.axis);
+  if (!std::isfinite(z_mm) || !(az > 0.0)) return H;
+  return std::clamp((z_mm - p.tip.z + R * std::sqrt(std::max(0.0, 1.0 - az * az))) / az, 0.0, H);
+}
+
+// A sub-step is the convex hull of the modelled part K at its two poses; the tool swept
+// between them differs from it in two ways, each bounded by the chord tolerance:
+//  - the sagitta: a point at distance ρ from the tip describes an arc while the axis turns
+//    by φ; the hull holds its chord, ρ·(1 − cos(φ/2)) inside it (under-cut);
+//  - the twist (over-cut, first order in φ). A point of the hull's boundary that lies
+//    outside both poses' tools lies on a bridge Q = (1 − λ)·x₀ + λ·y₁ between the support
+//    points x, y ∈ K of one direction at the two poses, which lies
+//    λ(1 − λ)·|(R₁ − R₀)(y − x)| ≤ λ(1 − λ)·φ·|y − x| from the point (1 − λ)x + λy of
+//    the tool at the interpolated pose. Support points of directions φ apart lie on one
+//    flat feature of K (or O(φ) apart on a curved part): a straight piece of the profile
+//    (|y − x| = |Δh| times its slope, λ(1 − λ)|Δh| ≤ L/4, L the modelled part's axial
+//    span) or a flat end (|y − x| ≤ 2ρ: ρφ/2).
+// The axial term's offset of Q, ε·W with W = L·(a₁ − a₀) and |ε| ≤ 1/4, counts only across
+// the swept surface: the patch of a generator moving by V(s) = ΔA + s·W (A the part's
+// lowest axis point, s along it) holds, to first order, every offset along V and along the
+// axis, so Q lies about |ε|·|W·n̂| from it, n̂ ∝ a × V(s) (`across`, the largest
+// |W·n̂|/|W| over s; 1 where the axis turns about a point of the part, V = 0). A tool that
+// leans along its motion barely twists.
+// Heights sharpen both: Q.z lies between x₀.z and y₁.z, so λ(1 − λ)|y₁.z − x₀.z| ≤
+// min(Q.z − z_lo, z_hi − Q.z) over the part's height range [z_lo, z_hi], and |Δh|·a.z
+// differs from |y₁.z − x₀.z| by at most |Δtip.z| + L·|Δa.z| + 2ρφ; a flat end's bridges
+// lie within its own height range. Near the part's lowest points, where a finishing tool
+// cuts its surface, the axial term vanishes.
+// The capsule and the core are hulls of such a part (their segment; the core's disk)
+// grown by a ball of radius `ball`, which turns into itself: a plane's points come from
+// the part's heights within `ball` of the plane.
+int Sweep::TwistBound::count(double z_mm, double tol_mm) const noexcept {
+  if (!(angle > 1e-12)) return 1;
+  const bool all = std::isnan(z_mm);
+  const double lo = all ? -INFINITY : z_mm - ball, hi = all ? INFINITY : z_mm + ball;
+  double m = 0.5 * (z_hi - z_lo);  // the largest min(q − z_lo, z_hi − q), at the middle
+  const double mid = 0.5 * (z_lo + z_hi);
+  if (std::max(lo, z_lo) > std::min(hi, z_hi)) m = 0.0;
+  else if (hi < mid) m = hi - z_lo;
+  else if (lo > mid) m = z_hi - lo;
+  double excess = across * slope * (inv_az > 0.0 ? std::min(quarter_len, (m + slack) * inv_az) : quarter_len);
+  for (const Face& f : faces)
+    if (f.half_rho > 0.0 && lo <= f.z_hi && hi >= f.z_lo) excess = std::max(excess, f.half_rho);
+  double n = std::max(static_cast<double>(sagitta), std::ceil(angle * excess / tol_mm));
+  if (cross > 0.0) n = std::max(n, std::ceil(std::sqrt(angle * cross / tol_mm)));
+  return static_cast<int>(std::clamp(n, 1.0, static_cast<double>(kMaxTiltSubsteps)));
+}
+
+namespace {
+
+// TwistBound::across for a part whose lowest axis point moves from a0 to a1 and whose axis
+// span of length `len` turns by W (about the mean axis `a`, by `angle`): V(s) = (a1 − a0) +
+// s·W across the axis, split along ŵ = W/|W| (c + s·|W|) and across it (n, fixed);
+// |W·n̂|/|W| = |n|/|V(s)|, largest at the s in [0, 1] nearest to c + s·|W| = 0. The offset
+// along V that brings Q onto the patch is at most |W|/|V| of the move, so it stays on the
+// patch only where |W| <= |V|; elsewhere (a turn about a point of the part) 1. What the
+// first order leaves out is of the order of the turn itself, added.
+double across_share(const Vec3& a0, const Vec3& a1, const Vec3& w, const Vec3& a, double angle) noexcept {
+  const double wl = norm(w);
+  if (!(wl > 1e-12)) return 0.0;
+  const Vec3 w_hat = (1.0 / wl) * w;
+  Vec3 d = a1 - a0;
+  d = d - dot(d, a) * a;
+  const double c = dot(d, w_hat);
+  const double n = norm(d - c * w_hat);
+  const double s = std::clamp(-c / wl, 0.0, 1.0);
+  const double v = std::hypot(n, c + s * wl);  // the least |V(s)| over [0, 1]
+  return v >= wl ? std::min(1.0, n / v + angle) : 1.0;
+}
+
+}  // namespace
+
+void Sweep::prepare_twist_bound() noexcept {
+  const CutterShape& s = *shape_;
+  TwistBound& b = twist_;
+  b.angle = std::acos(std::clamp(dot(from_.axis, to_.axis), -1.0, 1.0));
+  if (!(b.angle > 1e-12)) return;
+  const double tol = s.chord_tol_mm;
+  const double c = 1.0 - std::min(1.0, tol / std::hypot(top_, s.radius()));
+  b.sagitta = static_cast<int>(std::clamp(std::ceil(b.angle / (2.0 * std::acos(c))), 1.0, static_cast<double>(kMaxTiltSubsteps)));
+  // The part: axial heights [h0, top_], its flat ends' radii, its widest radius.
+  double h0 = 0.0, rho = 0.0, end0 = 0.0, end1 = 0.0;
+  if (s.capsule_radius_mm > 0.0) {
+    h0 = std::min(s.capsule_radius_mm, top_);
+    rho = end0 = end1 = s.core_radius_mm;
+    b.ball = s.capsule_radius_mm;
+  } else {
+    h0 = s.stations.front().h;
+    end0 = s.stations.front().r;
+    end1 = s.radius_at(top_);
+    for (std::size_t i = 0; i < s.stations.size(); ++i) {
+      rho = std::max(rho, s.stations[i].r);
+      if (i > 0 && s.stations[i - 1].h < top_) {
+        const double g = (s.stations[i].r - s.stations[i - 1].r) / (s.stations[i].h - s.stations[i - 1].h);
+        b.slope = std::max(b.slope, std::sqrt(1.0 + g * g));
+      }
+    }
+  }
+  const double len = top_ - h0;
+  b.quarter_len = 0.25 * len;
+  // Heights over both poses, widened by what the axis's arc between them may add.
+  const double arc = (top_ + rho) * (1.0 - std::cos(0.5 * b.angle)) + 1e-9;
+  auto widen = [](double& lo, double& hi, double z0, double z1) {
+    lo = std::min(lo, std::min(z0, z1));
+    hi = std::max(hi, std::max(z0, z1));
+  };
+  double az_min = INFINITY;
+  b.z_lo = b.faces[0].z_lo = b.faces[1].z_lo = INFINITY;
+  b.z_hi = b.faces[0].z_hi = b.faces[1].z_hi = -INFINITY;
+  for (const Pose* p : {&from_, &to_}) {
+    const double az = p->axis.z, sn = std::sqrt(std::max(0.0, 1.0 - az * az));
+    az_min = std::min(az_min, az);
+    const double z0 = p->tip.z + h0 * az, z1 = p->tip.z + top_ * az;
+    widen(b.z_lo, b.z_hi, std::min(z0, z1) - rho * sn - arc, std::max(z0, z1) + rho * sn + arc);
+    widen(b.faces[0].z_lo, b.faces[0].z_hi, z0 - end0 * sn - arc, z0 + end0 * sn + arc);
+    widen(b.faces[1].z_lo, b.faces[1].z_hi, z1 - end1 * sn - arc, z1 + end1 * sn + arc);
+  }
+  b.faces[0].half_rho = 0.5 * end0;
+  b.faces[1].half_rho = 0.5 * end1;
+  b.slack = 0.25 * (std::abs(to_.tip.z - from_.tip.z) + len * std::abs(to_.axis.z - from_.axis.z) + 2.0 * rho * b.angle);
+  b.inv_az = az_min > 1e-3 ? 1.0 / az_min : 0.0;
+  b.across = across_share(from_.tip + h0 * from_.axis, to_.tip + h0 * to_.axis, len * (to_.axis - from_.axis),
+                          normalized(from_.axis + to_.axis), b.angle);
+  if (s.capsule_radius_mm > 0.0 && s.core_radius_mm == 0.0) {
+    // The capsule: the segment's ends' heights change by at most |Δtip.z| + L·|Δa.z|.
+    b.quarter_len = 0.0;
+    const double dz = std::abs(to_.tip.z - from_.tip.z) + top_ * std::abs(to_.axis.z - from_.axis.z);
+    b.cross = 0.25 * dz * (b.inv_az > 0.0 ? b.inv_az : 1e3);
+  }
+}
+
+int Sweep::substeps_at(double z_mm) const noexcept { static const bool g = std::getenv("LBR_GLOBAL") != nullptr; if (g) return substeps_; return std::min(substeps_, twist_.count(z_mm, shape_->chord_tol_mm)); }
+
+Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double z_top_mm) noexcept
     : shape_(&shape), from_(from), to_(to) {
   from_.axis = normalized(from_.axis);
   to_.axis = normalized(to_.axis);
@@ -463,27 +625,26 @@ Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcep
     box_.add({to.tip.x + R, to.tip.y + R, to.tip.z + H});
     return;
   }
-  // Sub-steps: the chord between two interpolated poses stays within tolerance of the arc
-  // a tool point describes while the axis turns.
-  const double cosang = std::clamp(dot(from_.axis, to_.axis), -1.0, 1.0);
-  const double ang = std::acos(cosang);
-  if (ang > 1e-12) {
-    const double reach = std::hypot(H, R);
-    const double c = 1.0 - std::min(1.0, shape.chord_tol_mm / reach);
-    const double step = 2.0 * std::acos(c);
-    substeps_ = std::clamp(static_cast<int>(std::ceil(ang / step)), 1, kMaxTiltSubsteps);
-  }
+  // The part that may cut: up to the higher of the two poses' cut heights, and never below
+  // the capsule's or core's centre. Between the poses the tool's points move on arcs, whose
+  // lowest point lies at most their sagitta, reach·(1 − cos(φ/2)), below the chord between
+  // the ends' (the tip moves linearly), so the cut height is taken that much lower.
+  const double turn = std::acos(std::clamp(dot(from_.axis, to_.axis), -1.0, 1.0));
+  const double dip = std::hypot(H, R) * (1.0 - std::cos(0.5 * turn)) + 1e-6;
+  top_ = std::max(cut_height_below(shape, from_, z_top_mm + dip), cut_height_below(shape, to_, z_top_mm + dip));
+  top_ = std::clamp(top_, std::min(H, shape.capsule_radius_mm), H);
+  prepare_twist_bound();
+  substeps_ = twist_.count(NAN, shape.chord_tol_mm);
   for (int k = 0; k <= substeps_; ++k) {
     const double t = static_cast<double>(k) / substeps_;
-    const Vec3 tip = lerp(from_.tip, to_.tip, t);
-    const Vec3 ax = normalized(lerp(from_.axis, to_.axis, t));
-    for (const auto& st : shape.stations) {
-      const Vec3 c = tip + st.h * ax;
-      const Vec3 e{st.r * std::sqrt(std::max(0.0, 1 - ax.x * ax.x)), st.r * std::sqrt(std::max(0.0, 1 - ax.y * ax.y)),
-                   st.r * std::sqrt(std::max(0.0, 1 - ax.z * ax.z))};
+    const Pose p{lerp(from_.tip, to_.tip, t), normalized(lerp(from_.axis, to_.axis, t))};
+    for_each_station_circle(shape, p, top_, [&](const Circle& ci) {
+      const Vec3 c{ci.c.x, ci.c.y, ci.c.z};
+      const Vec3 e{ci.r * std::sqrt(std::max(0.0, 1 - ci.n.x * ci.n.x)), ci.r * std::sqrt(std::max(0.0, 1 - ci.n.y * ci.n.y)),
+                   ci.r * std::sqrt(std::max(0.0, 1 - ci.n.z * ci.n.z))};
       box_.add(c - e);
       box_.add(c + e);
-    }
+    });
   }
 }
 
@@ -1104,11 +1265,12 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
   if (ns > kMaxStations) return 0;
   std::size_t added = 0;
   Pose a{from_.tip, from_.axis};
-  for (int k = 1; k <= substeps_; ++k) {
-    const double t = static_cast<double>(k) / substeps_;
+  const int n = substeps_at(zc);
+  for (int k = 1; k <= n; ++k) {
+    const double t = static_cast<double>(k) / n;
     const Pose b{lerp(from_.tip, to_.tip, t), normalized(lerp(from_.axis, to_.axis, t))};
-    int nc = station_circles(s, a, circles);
-    nc += station_circles(s, b, circles + nc);
+    int nc = station_circles(s, a, top_, circles);
+    nc += station_circles(s, b, top_, circles + nc);
     const Pose pa = a;
     a = b;
     // Quick z test for this sub-step.
@@ -1118,7 +1280,7 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
       zlo = std::min(zlo, circles[i].c.z - e);
       zhi = std::max(zhi, circles[i].c.z + e);
     }
-    const Hull3 hull(&s, pa, b);
+    const Hull3 hull(&s, pa, b, top_);
     hull.clamp_z_extent(zlo, zhi);
     if (zc < zlo || zc > zhi) continue;
     if (material != nullptr && beside_material(hull, circles, nc, *material)) continue;
@@ -1138,7 +1300,7 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
 
 std::size_t Sweep::build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
                                SectionScratch& sc) const {
-  const Hull3 hull(shape_, p.a, p.b);
+  const Hull3 hull(shape_, p.a, p.b, top_);
   refine_section(hull, p, shape_->chord_tol_mm, cover0, cover1, sc);
   sc.support_queries += hull.queries;
   convex_hull(sc.pts, sc.hull);

@@ -198,14 +198,14 @@ Intrusion CollisionChecker::cutting_intrusion(const geom::LbrSolid& solid, const
 Intrusion CollisionChecker::tool_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m,
                                            const geom::Pose& from, const geom::Pose& to) {
   const double margin = probe_margin(config_, solid);
-  const geom::Sweep sweep(*m.ref.shape, from, to);
+  const geom::Sweep sweep(*m.ref.shape, from, to, solid.z_top_mm());
   const auto parts = parts_.find(m.tool);
   // The inner tool stands for this margin only (the tool table's chord tolerance is the
   // solid's whenever both come from one profile).
   if (parts == parts_.end() || !parts->second.has_inner || parts->second.inner_margin_mm != margin)
     return probe_.measure(solid, sweep, margin, contact_only_);
   const Parts& p = parts->second;
-  const geom::Sweep inner(p.inner, raised(from, p.inner_raise_mm), raised(to, p.inner_raise_mm));
+  const geom::Sweep inner(p.inner, raised(from, p.inner_raise_mm), raised(to, p.inner_raise_mm), solid.z_top_mm());
   return probe_.measure(solid, sweep, margin, contact_only_, &inner);
 }
 
@@ -224,7 +224,8 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
     const double angle = descent_deg(m.ref.from, m.ref.to);
     if (angle > config_.max_ramp_angle_deg) {
       const Intrusion in =
-          probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to), probe_margin(config_, solid), contact_only_);
+          probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to, solid.z_top_mm()), probe_margin(config_, solid),
+                         contact_only_);
       if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
     }
   }
@@ -236,7 +237,7 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
 
 bool CollisionChecker::raised_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m,
                                       const geom::CutterShape& part, double from_mm, EventKind kind, Finding& out) {
-  const geom::Sweep sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm));
+  const geom::Sweep sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm), solid.z_top_mm());
   const Intrusion in = probe_.measure(solid, sweep, probe_margin(config_, solid), contact_only_);
   if (!(in.deep_mm3 > 0.0)) return false;
   out = {kind, in};

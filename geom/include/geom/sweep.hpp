@@ -8,14 +8,16 @@
 // straight move with a fixed axis sweeps a convex solid and the section is computed
 // exactly up to the polygonisation of circles, which keeps every boundary point within the
 // chord tolerance of the exact section. For a flat end mill the linear profile is exact, so
-// the only error is polygonisation. Moves whose axis changes are subdivided so that no
-// point of the tool leaves the chord tolerance of the linear interpolation between
-// sub-steps. A tilted ball end mill (CutterShape::capsule_radius_mm) is taken as its exact
+// the only error is polygonisation. Moves whose axis changes are subdivided, per plane, so
+// that the hull of each sub-step's two poses stays within the chord tolerance of the tool
+// swept between them (its chords' sagitta and its twist: docs/lbr-conventions.md, "Tilted
+// sub-steps"). A tilted ball end mill (CutterShape::capsule_radius_mm) is taken as its exact
 // capsule instead of the profile polyline; its section points have a closed form. A tilted
 // bull-nose mill (CutterShape::core_radius_mm) is taken as its exact torus and cylinder the
 // same way (a disk swept along the axis, grown by the corner radius).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -136,10 +138,21 @@ struct TiltedPiece {
 // then unchanged and can be dropped). `flags` is a reusable buffer.
 bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, double margin = 2.0);
 
+// The axial height above the tip [mm] from which the cutting part of `shape` at pose p
+// lies wholly above z_mm (a point at height h on the axis and within the tool's radius R of
+// it lies no lower than tip.z + h·a.z − R·sqrt(1 − a.z²)), clamped to [0, height()];
+// height() when z_mm is infinite or the axis does not point up.
+[[nodiscard]] double cut_height_below(const CutterShape& shape, const Pose& p, double z_mm) noexcept;
+
 class Sweep {
  public:
   // Does not allocate beyond the sub-step list (fixed capacity). Real-time safe.
-  Sweep(const CutterShape& shape, const Pose& from, const Pose& to) noexcept;
+  // `z_top_mm` is the top of the material the sweep may cut (the solid's top): a tilted
+  // sweep then models only the part of the tool from the tip up to the larger of its two
+  // poses' cut_height_below() (what lies above cuts nothing there, at any pose between
+  // them), which shortens its hull's excess and so its sub-steps. Infinite: the whole
+  // cutting part.
+  Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double z_top_mm = INFINITY) noexcept;
 
   // Height range [mm] touched by the cutting part of the sweep.
   [[nodiscard]] double z_min() const noexcept { return box_.lo.z; }
@@ -211,10 +224,41 @@ class Sweep {
   // The disks whose hull is the section on z = zc (vertical sweeps); false when none.
   bool section_disks(double zc, SectionScratch& sc) const;
 
+  // What bounds a tilted sweep's sub-steps (docs/lbr-conventions.md, "Tolerances"): the
+  // chords' sagitta, and the hull's twist excess, which depends on the plane.
+  struct TwistBound {
+    double angle = 0.0;         // the axis's turn over the sweep [rad]
+    int sagitta = 1;            // sub-steps for the sagitta
+    double quarter_len = 0.0;   // L/4, L the modelled part's axial span [mm]
+    double slope = 1.0;         // the profile's steepest |dρ/dh|, as sqrt(1 + (dρ/dh)²)
+    double across = 1.0;        // the share of the axial term across the swept surface (<= 1)
+    double z_lo = 0.0, z_hi = 0.0;  // that part's height range over the sweep [mm]
+    double ball = 0.0;          // the model's rounding radius (capsule, core; 0: stations) [mm]
+    double slack = 0.0;         // (|Δtip.z| + L·|Δa.z| + 2ρ·φ)/4 [mm]
+    double inv_az = 0.0;        // 1 / the least a.z (0: an axis not pointing up)
+    struct Face {
+      double half_rho = 0.0;    // ρ/2, ρ the flat face's radius [mm]
+      double z_lo = 0.0, z_hi = 0.0;  // its height range over the sweep [mm]
+    };
+    Face faces[2];              // the modelled part's flat ends: at the tip's end, at its top
+    // The capsule's section needs no twist term (its section is that of the hull of four of
+    // the tetrahedron's edges: docs/lbr-conventions.md): only the crossing term, `cross`·φ/n²
+    // for n sub-steps [mm/rad].
+    double cross = 0.0;
+    // Sub-steps on the planes whose points of the hull come from heights within `ball` of
+    // z_mm (all planes: z_mm = NaN).
+    [[nodiscard]] int count(double z_mm, double tol_mm) const noexcept;
+  };
+  void prepare_twist_bound() noexcept;
+  // Sub-steps of this tilted sweep on plane z = z_mm (at most substeps_).
+  [[nodiscard]] int substeps_at(double z_mm) const noexcept;
+
   const CutterShape* shape_;
   Pose from_, to_;
   bool vertical_ = true;
   int substeps_ = 1;
+  double top_ = 0.0;  // tilted sweeps: the modelled part's top, axial height above the tip [mm]
+  TwistBound twist_;
   Box3 box_;
 };
 
