@@ -820,4 +820,8 @@ TEST(Sweep, TurningFlatToolSectionsMatchTheUnionOfItsPoses) {
   expect_sections_match_union(along, {0.0, 2.0, 8.0, 15.0, 25.0}, -8.0, 8.0, tol, flat_row);
   const geom::Sweep diagonal(shape, test::at(0, 0, 0, lean(0.1, 0.3)), test::at(3, 0, -0.2, lean(0.13, 0.33)));
   expect_sections_match_union(diagonal, {0.0, 2.0, 8.0, 15.0, 25.0}, -12.0, 8.0, tol, flat_row);
+  // Ramping down 1 mm while it leans: the face moves along its axis by more than 3ρφ, which
+  // holds the offsets of its turn (no face term).
+  const geom::Sweep ramp(shape, test::at(0, 0, 0, lean(0.0, 0.3)), test::at(0.5, 0, -1.0, lean(0.05, 0.35)));
+  expect_sections_match_union(ramp, {-1.2, -0.8, -0.3, 0.5, 4.0}, -8.0, 8.0, tol, flat_row);
 }

@@ -16,7 +16,6 @@
 #include <array>
 #include <cmath>
 #include <numbers>
-#include <cstdlib>
 
 namespace lbr::geom {
 
@@ -495,7 +494,8 @@ double cut_height_below(const CutterShape& shape, const Pose& p, double z_mm) no
 //    the tool at the interpolated pose. Support points of directions φ apart lie on one
 //    flat feature of K (or O(φ) apart on a curved part): a straight piece of the profile
 //    (|y − x| = |Δh| times its slope, λ(1 − λ)|Δh| ≤ L/4, L the modelled part's axial
-//    span) or a flat end (|y − x| ≤ 2ρ: ρφ/2).
+//    span) or a flat end (|y − x| ≤ 2ρ: ρφ/2, along the axis; none where the end moves
+//    along the axis by 3ρφ or more, which holds such offsets).
 // The axial term's offset of Q, ε·W with W = L·(a₁ − a₀) and |ε| ≤ 1/4, counts only across
 // the swept surface: the patch of a generator moving by V(s) = ΔA + s·W (A the part's
 // lowest axis point, s along it) holds, to first order, every offset along V and along the
@@ -510,7 +510,8 @@ double cut_height_below(const CutterShape& shape, const Pose& p, double z_mm) no
 // The capsule and the core are hulls of such a part (their segment; the core's disk)
 // grown by a ball of radius `ball`, which turns into itself: a plane's points come from
 // the part's heights within `ball` of the plane.
-int Sweep::TwistBound::count(double z_mm, double tol_mm) const noexcept {
+int Sweep::TwistBound::count(double z_mm) const noexcept {
+  const double tol_mm = tol;
   if (!(angle > 1e-12)) return 1;
   const bool all = std::isnan(z_mm);
   const double lo = all ? -INFINITY : z_mm - ball, hi = all ? INFINITY : z_mm + ball;
@@ -551,9 +552,10 @@ double across_share(const Vec3& a0, const Vec3& a1, const Vec3& w, const Vec3& a
 
 }  // namespace
 
-void Sweep::prepare_twist_bound() noexcept {
+void Sweep::prepare_twist_bound(double twist_tol_mm) noexcept {
   const CutterShape& s = *shape_;
   TwistBound& b = twist_;
+  b.tol = std::max(s.chord_tol_mm, twist_tol_mm);
   b.angle = std::acos(std::clamp(dot(from_.axis, to_.axis), -1.0, 1.0));
   if (!(b.angle > 1e-12)) return;
   const double tol = s.chord_tol_mm;
@@ -596,8 +598,16 @@ void Sweep::prepare_twist_bound() noexcept {
     widen(b.faces[0].z_lo, b.faces[0].z_hi, z0 - end0 * sn - arc, z0 + end0 * sn + arc);
     widen(b.faces[1].z_lo, b.faces[1].z_hi, z1 - end1 * sn - arc, z1 + end1 * sn + arc);
   }
-  b.faces[0].half_rho = 0.5 * end0;
-  b.faces[1].half_rho = 0.5 * end1;
+  // A flat end's offsets are along the axis; a face that moves along the axis by at least
+  // 3ρφ (its centre's motion, less what the turn moves its rim) holds them in the region it
+  // sweeps, |ε| <= t(1 − t) of the move from either end.
+  const Vec3 mean_axis = normalized(from_.axis + to_.axis);
+  auto face_term = [&](double h, double r) {
+    const double along = std::abs(dot((to_.tip + h * to_.axis) - (from_.tip + h * from_.axis), mean_axis));
+    return along >= 3.0 * r * b.angle ? 0.0 : 0.5 * r;
+  };
+  b.faces[0].half_rho = face_term(h0, end0);
+  b.faces[1].half_rho = face_term(top_, end1);
   b.slack = 0.25 * (std::abs(to_.tip.z - from_.tip.z) + len * std::abs(to_.axis.z - from_.axis.z) + 2.0 * rho * b.angle);
   b.inv_az = az_min > 1e-3 ? 1.0 / az_min : 0.0;
   b.across = across_share(from_.tip + h0 * from_.axis, to_.tip + h0 * to_.axis, len * (to_.axis - from_.axis),
@@ -610,9 +620,9 @@ void Sweep::prepare_twist_bound() noexcept {
   }
 }
 
-int Sweep::substeps_at(double z_mm) const noexcept { static const bool g = std::getenv("LBR_GLOBAL") != nullptr; if (g) return substeps_; return std::min(substeps_, twist_.count(z_mm, shape_->chord_tol_mm)); }
+int Sweep::substeps_at(double z_mm) const noexcept { return std::min(substeps_, twist_.count(z_mm)); }
 
-Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double z_top_mm) noexcept
+Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double z_top_mm, double twist_tol_mm) noexcept
     : shape_(&shape), from_(from), to_(to) {
   from_.axis = normalized(from_.axis);
   to_.axis = normalized(to_.axis);
@@ -633,8 +643,8 @@ Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double 
   const double dip = std::hypot(H, R) * (1.0 - std::cos(0.5 * turn)) + 1e-6;
   top_ = std::max(cut_height_below(shape, from_, z_top_mm + dip), cut_height_below(shape, to_, z_top_mm + dip));
   top_ = std::clamp(top_, std::min(H, shape.capsule_radius_mm), H);
-  prepare_twist_bound();
-  substeps_ = twist_.count(NAN, shape.chord_tol_mm);
+  prepare_twist_bound(twist_tol_mm);
+  substeps_ = twist_.count(NAN);
   for (int k = 0; k <= substeps_; ++k) {
     const double t = static_cast<double>(k) / substeps_;
     const Pose p{lerp(from_.tip, to_.tip, t), normalized(lerp(from_.axis, to_.axis, t))};

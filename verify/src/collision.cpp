@@ -176,6 +176,12 @@ namespace {
 double probe_margin(const CheckConfig& c, const geom::LbrSolid& solid) noexcept {
   return probe_margin(c, solid.spec().chord_tol_mm);
 }
+
+// How far a checked part's tilted sub-step (the tool where it must not cut, its shank,
+// holder, the spindle nose) may stand out of its sweep (geom::Sweep's twist_tol_mm): half
+// the checks' tolerance, inside the probe's margin, so that it raises no finding the exact
+// sweep would not (docs/verification.md).
+double part_twist_tol(const CheckConfig& c) noexcept { return 0.5 * c.tolerance_mm; }
 }  // namespace
 
 int CollisionChecker::tool_change_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m, Findings& out,
@@ -198,14 +204,15 @@ Intrusion CollisionChecker::cutting_intrusion(const geom::LbrSolid& solid, const
 Intrusion CollisionChecker::tool_intrusion(const geom::LbrSolid& solid, const motion::TimedSweep& m,
                                            const geom::Pose& from, const geom::Pose& to) {
   const double margin = probe_margin(config_, solid);
-  const geom::Sweep sweep(*m.ref.shape, from, to, solid.z_top_mm());
+  const geom::Sweep sweep(*m.ref.shape, from, to, solid.z_top_mm(), part_twist_tol(config_));
   const auto parts = parts_.find(m.tool);
   // The inner tool stands for this margin only (the tool table's chord tolerance is the
   // solid's whenever both come from one profile).
   if (parts == parts_.end() || !parts->second.has_inner || parts->second.inner_margin_mm != margin)
     return probe_.measure(solid, sweep, margin, contact_only_);
   const Parts& p = parts->second;
-  const geom::Sweep inner(p.inner, raised(from, p.inner_raise_mm), raised(to, p.inner_raise_mm), solid.z_top_mm());
+  const geom::Sweep inner(p.inner, raised(from, p.inner_raise_mm), raised(to, p.inner_raise_mm), solid.z_top_mm(),
+                          part_twist_tol(config_));
   return probe_.measure(solid, sweep, margin, contact_only_, &inner);
 }
 
@@ -224,8 +231,8 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
     const double angle = descent_deg(m.ref.from, m.ref.to);
     if (angle > config_.max_ramp_angle_deg) {
       const Intrusion in =
-          probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to, solid.z_top_mm()), probe_margin(config_, solid),
-                         contact_only_);
+          probe_.measure(solid, geom::Sweep(p.core, m.ref.from, m.ref.to, solid.z_top_mm(), part_twist_tol(config_)),
+                         probe_margin(config_, solid), contact_only_);
       if (in.deep_mm3 > 0.0) out[n++] = {EventKind::Plunge, in, angle};
     }
   }
@@ -237,7 +244,8 @@ int CollisionChecker::part_findings(const geom::LbrSolid& solid, const motion::T
 
 bool CollisionChecker::raised_finding(const geom::LbrSolid& solid, const motion::TimedSweep& m,
                                       const geom::CutterShape& part, double from_mm, EventKind kind, Finding& out) {
-  const geom::Sweep sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm), solid.z_top_mm());
+  const geom::Sweep sweep(part, raised(m.ref.from, from_mm), raised(m.ref.to, from_mm), solid.z_top_mm(),
+                          part_twist_tol(config_));
   const Intrusion in = probe_.measure(solid, sweep, probe_margin(config_, solid), contact_only_);
   if (!(in.deep_mm3 > 0.0)) return false;
   out = {kind, in};

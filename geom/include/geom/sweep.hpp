@@ -151,8 +151,10 @@ class Sweep {
   // sweep then models only the part of the tool from the tip up to the larger of its two
   // poses' cut_height_below() (what lies above cuts nothing there, at any pose between
   // them), which shortens its hull's excess and so its sub-steps. Infinite: the whole
-  // cutting part.
-  Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double z_top_mm = INFINITY) noexcept;
+  // cutting part. `twist_tol_mm` bounds that excess (0: the shape's chord tolerance; the
+  // collision checks' non-cutting parts take half the checks' tolerance).
+  Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double z_top_mm = INFINITY,
+        double twist_tol_mm = 0.0) noexcept;
 
   // Height range [mm] touched by the cutting part of the sweep.
   [[nodiscard]] double z_min() const noexcept { return box_.lo.z; }
@@ -245,11 +247,12 @@ class Sweep {
     // the tetrahedron's edges: docs/lbr-conventions.md): only the crossing term, `cross`·φ/n²
     // for n sub-steps [mm/rad].
     double cross = 0.0;
+    double tol = 0.0;           // the excess allowed [mm]
     // Sub-steps on the planes whose points of the hull come from heights within `ball` of
     // z_mm (all planes: z_mm = NaN).
-    [[nodiscard]] int count(double z_mm, double tol_mm) const noexcept;
+    [[nodiscard]] int count(double z_mm) const noexcept;
   };
-  void prepare_twist_bound() noexcept;
+  void prepare_twist_bound(double twist_tol_mm) noexcept;
   // Sub-steps of this tilted sweep on plane z = z_mm (at most substeps_).
   [[nodiscard]] int substeps_at(double z_mm) const noexcept;
 
