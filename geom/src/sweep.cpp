@@ -511,7 +511,6 @@ double cut_height_below(const CutterShape& shape, const Pose& p, double z_mm) no
 // grown by a ball of radius `ball`, which turns into itself: a plane's points come from
 // the part's heights within `ball` of the plane.
 int Sweep::TwistBound::count(double z_mm) const noexcept {
-  const double tol_mm = tol;
   if (!(angle > 1e-12)) return 1;
   const bool all = std::isnan(z_mm);
   const double lo = all ? -INFINITY : z_mm - ball, hi = all ? INFINITY : z_mm + ball;
@@ -523,8 +522,8 @@ int Sweep::TwistBound::count(double z_mm) const noexcept {
   double excess = across * slope * (inv_az > 0.0 ? std::min(quarter_len, (m + slack) * inv_az) : quarter_len);
   for (const Face& f : faces)
     if (f.half_rho > 0.0 && lo <= f.z_hi && hi >= f.z_lo) excess = std::max(excess, f.half_rho);
-  double n = std::max(static_cast<double>(sagitta), std::ceil(angle * excess / tol_mm));
-  if (cross > 0.0) n = std::max(n, std::ceil(std::sqrt(angle * cross / tol_mm)));
+  double n = std::max(static_cast<double>(sagitta), std::ceil(angle * excess / tol));
+  if (cross > 0.0) n = std::max(n, std::ceil(std::sqrt(angle * cross / tol)));
   return static_cast<int>(std::clamp(n, 1.0, static_cast<double>(kMaxTiltSubsteps)));
 }
 
@@ -552,14 +551,14 @@ double across_share(const Vec3& a0, const Vec3& a1, const Vec3& w, const Vec3& a
 
 }  // namespace
 
-void Sweep::prepare_twist_bound(double twist_tol_mm) noexcept {
+void Sweep::prepare_twist_bound(double turn_rad, double twist_tol_mm) noexcept {
   const CutterShape& s = *shape_;
   TwistBound& b = twist_;
   b.tol = std::max(s.chord_tol_mm, twist_tol_mm);
-  b.angle = std::acos(std::clamp(dot(from_.axis, to_.axis), -1.0, 1.0));
+  b.angle = turn_rad;
   if (!(b.angle > 1e-12)) return;
-  const double tol = s.chord_tol_mm;
-  const double c = 1.0 - std::min(1.0, tol / std::hypot(top_, s.radius()));
+  // The sagitta (an under-cut) keeps the chord tolerance whatever twist_tol_mm says.
+  const double c = 1.0 - std::min(1.0, s.chord_tol_mm / std::hypot(top_, s.radius()));
   b.sagitta = static_cast<int>(std::clamp(std::ceil(b.angle / (2.0 * std::acos(c))), 1.0, static_cast<double>(kMaxTiltSubsteps)));
   // The part: axial heights [h0, top_], its flat ends' radii, its widest radius.
   double h0 = 0.0, rho = 0.0, end0 = 0.0, end1 = 0.0;
@@ -610,10 +609,11 @@ void Sweep::prepare_twist_bound(double twist_tol_mm) noexcept {
   b.faces[1].half_rho = face_term(top_, end1);
   b.slack = 0.25 * (std::abs(to_.tip.z - from_.tip.z) + len * std::abs(to_.axis.z - from_.axis.z) + 2.0 * rho * b.angle);
   b.inv_az = az_min > 1e-3 ? 1.0 / az_min : 0.0;
-  b.across = across_share(from_.tip + h0 * from_.axis, to_.tip + h0 * to_.axis, len * (to_.axis - from_.axis),
-                          normalized(from_.axis + to_.axis), b.angle);
+  b.across = across_share(from_.tip + h0 * from_.axis, to_.tip + h0 * to_.axis, len * (to_.axis - from_.axis), mean_axis,
+                          b.angle);
   if (s.capsule_radius_mm > 0.0 && s.core_radius_mm == 0.0) {
-    // The capsule: the segment's ends' heights change by at most |Δtip.z| + L·|Δa.z|.
+    // The capsule: the segment's ends' heights change by at most |Δtip.z| + L·|Δa.z|; over
+    // a.z, which an axis at or below level (inv_az = 0) takes as 1/1000.
     b.quarter_len = 0.0;
     const double dz = std::abs(to_.tip.z - from_.tip.z) + top_ * std::abs(to_.axis.z - from_.axis.z);
     b.cross = 0.25 * dz * (b.inv_az > 0.0 ? b.inv_az : 1e3);
@@ -643,7 +643,7 @@ Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double 
   const double dip = std::hypot(H, R) * (1.0 - std::cos(0.5 * turn)) + 1e-6;
   top_ = std::max(cut_height_below(shape, from_, z_top_mm + dip), cut_height_below(shape, to_, z_top_mm + dip));
   top_ = std::clamp(top_, std::min(H, shape.capsule_radius_mm), H);
-  prepare_twist_bound(twist_tol_mm);
+  prepare_twist_bound(turn, twist_tol_mm);
   substeps_ = twist_.count(NAN);
   for (int k = 0; k <= substeps_; ++k) {
     const double t = static_cast<double>(k) / substeps_;

@@ -252,7 +252,7 @@ class Sweep {
     // z_mm (all planes: z_mm = NaN).
     [[nodiscard]] int count(double z_mm) const noexcept;
   };
-  void prepare_twist_bound(double twist_tol_mm) noexcept;
+  void prepare_twist_bound(double turn_rad, double twist_tol_mm) noexcept;
   // Sub-steps of this tilted sweep on plane z = z_mm (at most substeps_).
   [[nodiscard]] int substeps_at(double z_mm) const noexcept;
 
