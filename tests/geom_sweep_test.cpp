@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <random>
 #include <cstdint>
 #include <cstdio>
 #include <initializer_list>
@@ -378,19 +379,72 @@ TEST(Sweep, TiltedPiecesWithNeighbourCoversKeepTheUnionWithFewerVertices) {
       sw.build_piece(pieces[i], nullptr, nullptr, full, sc);
     }
     ASSERT_EQ(full.size(), pieces.size());
-    std::size_t vc = 0, vf = 0;
+    // The engine's way since: the previous piece's refined polygon covers too
+    // (build_piece's after_last; its own scratch, so that each call follows the one before).
+    geom::SectionScratch sc_last;
+    geom::Paths after_last;
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+      sweeps[pieces[i].sweep].build_piece(pieces[i], i > 0 ? &pieces[i - 1] : nullptr,
+                                          i + 1 < pieces.size() ? &pieces[i + 1] : nullptr, after_last, sc_last, i > 0);
+    std::size_t vc = 0, vf = 0, vl = 0;
     for (const auto& p : covered) vc += p.size();
     for (const auto& p : full) vf += p.size();
+    for (const auto& p : after_last) vl += p.size();
     EXPECT_LT(vc * 2, vf) << "z " << z << ": " << vc << " vertices with covers, " << vf << " without";
+    EXPECT_LT(vl, vc) << "z " << z << ": " << vl << " vertices with the last polygon, " << vc << " with coarse covers";
     // Perimeter of the union about 2 · 6.5 + 2π · 3.3 mm; chord tolerance on it.
-    const double af = union_area(full), ac = union_area(covered);
+    const double af = union_area(full), ac = union_area(covered), al = union_area(after_last);
     EXPECT_GT(af, 30.0);
     EXPECT_NEAR(ac, af, 40.0 * tol) << "z " << z;
+    EXPECT_NEAR(al, af, 40.0 * tol) << "z " << z;
     // The same with one piece's neighbours missing: its own arcs are then refined in full.
     geom::Paths alone;
     sweeps[pieces[5].sweep].build_piece(pieces[5], nullptr, nullptr, alone, sc);
     EXPECT_NEAR(union_area(alone), union_area(geom::Paths{full[5]}), 1e-9);
   }
+}
+
+TEST(ConvexCover, HoldsThePointsInsideThePolygonByTheMargin) {
+  // A regular 60-gon of radius 3 about (1, −2) and a margin of 0.05 mm: contains() must
+  // agree with the least distance to the edges' lines (brute force) wherever that distance
+  // is not within 1e-9 mm of the margin.
+  std::vector<geom::SectionPoint> poly;
+  constexpr int n = 60;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2.0 * test::kPi * i / n;
+    poly.push_back({1.0 + 3.0 * std::cos(a), -2.0 + 3.0 * std::sin(a)});
+  }
+  const double m = 0.05;
+  geom::ConvexCover cover;
+  cover.build(poly, m);
+  ASSERT_FALSE(cover.empty());
+  auto depth = [&](const geom::SectionPoint& q) {
+    double d = INFINITY;
+    for (int i = 0; i < n; ++i) {
+      const auto& a = poly[static_cast<std::size_t>(i)];
+      const auto& b = poly[static_cast<std::size_t>((i + 1) % n)];
+      const double ex = b.x - a.x, ey = b.y - a.y, l = std::hypot(ex, ey);
+      d = std::min(d, ((q.x - a.x) * ey - (q.y - a.y) * ex) / -l);  // > 0 inside (counter-clockwise)
+    }
+    return d;
+  };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-3.5, 3.5);
+  int inside = 0, outside = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const geom::SectionPoint q{1.0 + u(rng), -2.0 + u(rng)};
+    const double d = depth(q);
+    if (std::abs(d - m) < 1e-9) continue;
+    EXPECT_EQ(cover.contains(q), d > m) << "q (" << q.x << ", " << q.y << "), depth " << d;
+    (d > m ? inside : outside)++;
+  }
+  EXPECT_GT(inside, 5000);
+  EXPECT_GT(outside, 5000);
+  // An edge shorter than the margin can carry turns away: such a polygon covers nothing.
+  cover.build({{0, 0}, {1, 0}, {0.5, 0.01}}, m);
+  EXPECT_TRUE(cover.empty());
+  cover.build({{0, 0}, {1, 0}}, m);
+  EXPECT_TRUE(cover.empty());
 }
 
 TEST(Sweep, TiltedSectionVerticesLieOnTheEllipseWithinThePointAccuracy) {

@@ -307,7 +307,7 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
     const TiltedPiece& p = ws.pieces[i];
     const std::size_t before = ls.paths.size();
     sh.sweeps[p.sweep].build_piece(p, i > 0 ? &ws.pieces[i - 1] : prior, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
-                                   ls.paths, ws.scratch);
+                                   ls.paths, ws.scratch, i > 0);
     if (ls.paths.size() > before) id = std::max(id, sh.sweep_id[p.sweep]);
     if (ls.paths.size() - ls.box.size() >= kTiltedGroup) {
       join_tilted(ls.box.size(), id, ws, ls, stats);

@@ -1048,6 +1048,10 @@ namespace {
 
 constexpr double kPointEps = 0.05;  // boundary points to tol/20 (of the chord tolerance)
 
+// How far inside a cover a refinement triangle must lie: the points' accuracy and a kernel
+// unit for the rounding of the cover's polygon.
+double cover_margin(double tol) noexcept { return kPointEps * tol + 1.0 / kUnitsPerMm; }
+
 // The kDirs directions of the coarse points as unit vectors (cos, sin of 2πi/kDirs).
 const std::array<SectionScratch::P2, TiltedPiece::kDirs>& coarse_directions() noexcept {
   static const std::array<SectionScratch::P2, TiltedPiece::kDirs> dirs = [] {
@@ -1074,7 +1078,7 @@ const std::array<SectionScratch::P2, TiltedPiece::kDirs>& coarse_directions() no
 // lies inside a cover's coarse polygon: what the chord leaves out there is removed by the
 // cover's own polygon.
 void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const TiltedPiece* cover0,
-                    const TiltedPiece* cover1, SectionScratch& sc) {
+                    const TiltedPiece* cover1, const ConvexCover* last, SectionScratch& sc) {
   constexpr int kStart = TiltedPiece::kDirs;
   constexpr int kMaxPoints = 8192;
   constexpr int kWarmSteps = 1;  // a middle direction starts from its neighbours' brackets
@@ -1100,10 +1104,11 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
   // The triangle of interval iv lies inside a cover (its three corners do; margin: the
   // point accuracy and a kernel unit for the rounding of the cover's polygon). Which covers
   // hold a point is found once per point: each end is shared by two intervals.
-  const double margin = eps + 1.0 / kUnitsPerMm;
-  const bool any_cover = cover0 != nullptr || cover1 != nullptr;
+  const double margin = cover_margin(tol);
+  const bool any_cover = cover0 != nullptr || cover1 != nullptr || last != nullptr;
   auto mask_of = [&](const P2& q) {
-    return (cover0 != nullptr && cover0->covers(q, margin) ? 1 : 0) | (cover1 != nullptr && cover1->covers(q, margin) ? 2 : 0);
+    return (cover0 != nullptr && cover0->covers(q, margin) ? 1 : 0) | (cover1 != nullptr && cover1->covers(q, margin) ? 2 : 0) |
+           (last != nullptr && last->contains(q) ? 4 : 0);
   };
   auto covered = [&](Iv& iv) {
     if (!any_cover) return false;
@@ -1116,7 +1121,8 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
     const double det = ax * by - ay * bx;  // sin(φb − φa) > 0
     if (!(det > 1e-12)) return false;
     const P2 apex{(ha * by - hb * ay) / det, (ax * hb - bx * ha) / det};
-    return ((both & 1) != 0 && cover0->covers(apex, margin)) || ((both & 2) != 0 && cover1->covers(apex, margin));
+    return ((both & 1) != 0 && cover0->covers(apex, margin)) || ((both & 2) != 0 && cover1->covers(apex, margin)) ||
+           ((both & 4) != 0 && last->contains(apex));
   };
   int coarse_mask[kStart];
   std::fill(std::begin(coarse_mask), std::end(coarse_mask), -1);
@@ -1255,6 +1261,87 @@ void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, cons
 
 }  // namespace
 
+namespace {
+// A pseudo-angle of (dx, dy) in [0, 4): increasing with the angle from +x counter-clockwise.
+double pseudo_angle(double dx, double dy) noexcept {
+  const double s = std::abs(dx) + std::abs(dy);
+  if (!(s > 0.0)) return 0.0;
+  return dy >= 0.0 ? 1.0 - dx / s : 3.0 + dx / s;
+}
+}  // namespace
+
+void ConvexCover::build(const std::vector<SectionPoint>& hull, double margin_mm) {
+  v_.clear();
+  kept_.clear();
+  const double min_len2 = 16.0 * margin_mm * margin_mm;  // edges of at least 4 margins
+  auto far = [&](const P2& a, const P2& b) { return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) >= min_len2; };
+  for (const P2& q : hull)
+    if (kept_.empty() || far(q, kept_.back())) kept_.push_back(q);
+  while (kept_.size() >= 3 && !far(kept_.front(), kept_.back())) kept_.pop_back();
+  const std::size_t n = kept_.size();
+  if (n < 3) return;
+  // Edge j runs from kept_[j] to kept_[j + 1]; its outward normal is (dy, −dx)/l. Vertex j
+  // moves to where its two edges' lines meet once moved in by the margin.
+  auto normal = [&](std::size_t j) {
+    const P2& a = kept_[j];
+    const P2& b = kept_[(j + 1) % n];
+    const double dx = b.x - a.x, dy = b.y - a.y, l = std::sqrt(dx * dx + dy * dy);
+    return P2{dy / l, -dx / l};
+  };
+  v_.resize(n);
+  P2 prev = normal(n - 1);
+  for (std::size_t j = 0; j < n; ++j) {
+    const P2 nj = normal(j);
+    const double d = 1.0 + prev.x * nj.x + prev.y * nj.y;
+    if (!(d > 1e-3)) {  // a turn of nearly 180°: no such hull
+      v_.clear();
+      return;
+    }
+    v_[j] = {kept_[j].x - margin_mm * (prev.x + nj.x) / d, kept_[j].y - margin_mm * (prev.y + nj.y) / d};
+    prev = nj;
+  }
+  // Every moved edge must keep its direction: then the moved polygon is convex, with its
+  // edges on the moved lines, and so the intersection of their half-planes.
+  c_ = {0.0, 0.0};
+  x0_ = y0_ = INFINITY;
+  x1_ = y1_ = -INFINITY;
+  for (std::size_t j = 0; j < n; ++j) {
+    const P2 &a = v_[j], &b = v_[(j + 1) % n], &oa = kept_[j], &ob = kept_[(j + 1) % n];
+    if (!((b.x - a.x) * (ob.x - oa.x) + (b.y - a.y) * (ob.y - oa.y) > 0.0)) {
+      v_.clear();
+      return;
+    }
+    c_.x += a.x / static_cast<double>(n);
+    c_.y += a.y / static_cast<double>(n);
+    x0_ = std::min(x0_, a.x);
+    x1_ = std::max(x1_, a.x);
+    y0_ = std::min(y0_, a.y);
+    y1_ = std::max(y1_, a.y);
+  }
+  // Starting from the vertex of the least pseudo-angle about the mean, the angles increase.
+  std::size_t first = 0;
+  ang_.resize(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    ang_[j] = pseudo_angle(v_[j].x - c_.x, v_[j].y - c_.y);
+    if (ang_[j] < ang_[first]) first = j;
+  }
+  std::rotate(v_.begin(), v_.begin() + static_cast<std::ptrdiff_t>(first), v_.end());
+  std::rotate(ang_.begin(), ang_.begin() + static_cast<std::ptrdiff_t>(first), ang_.end());
+  if (!std::is_sorted(ang_.begin(), ang_.end())) v_.clear();  // not star-shaped about c_ in angle order: cannot be
+}
+
+
+// The wedge at the mean point between rays to v_k and v_k+1 that holds q (bisection on
+// the vertices' pseudo-angles), then q against the edge v_k v_k+1.
+bool ConvexCover::contains(const SectionPoint& q) const noexcept {
+  const std::size_t n = v_.size();
+  if (n < 3 || q.x <= x0_ || q.x >= x1_ || q.y <= y0_ || q.y >= y1_) return false;
+  const double a = pseudo_angle(q.x - c_.x, q.y - c_.y);
+  const auto it = std::upper_bound(ang_.begin(), ang_.end(), a);
+  const std::size_t k = it == ang_.begin() ? n - 1 : static_cast<std::size_t>(it - ang_.begin()) - 1;
+  return cross2(v_[k], v_[k + 1 == n ? 0 : k + 1], q) > 0.0;
+}
+
 bool TiltedPiece::covers(const SectionScratch::P2& q, double margin_mm) const noexcept {
   if (edge_count == 0 || q.x <= x0 || q.x >= x1 || q.y <= y0 || q.y >= y1) return false;
   const double dx = q.x - cx, dy = q.y - cy, d2 = dx * dx + dy * dy;
@@ -1309,12 +1396,22 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
 }
 
 std::size_t Sweep::build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
-                               SectionScratch& sc) const {
+                               SectionScratch& sc, bool after_last) const {
   const Hull3 hull(shape_, p.a, p.b, top_);
-  refine_section(hull, p, shape_->chord_tol_mm, cover0, cover1, sc);
+  const double tol = shape_->chord_tol_mm;
+  // The capsule's boundary points are closed forms, about as cheap as a test against the
+  // last polygon: it keeps only the coarse covers. The last polygon, the previous piece's,
+  // holds that piece's coarse polygon, so it stands in for cover0 (the caller's previous
+  // piece) when there is one.
+  const bool bisected = !(shape_->capsule_radius_mm > 0.0 && shape_->core_radius_mm == 0.0);
+  const ConvexCover* last = bisected && after_last && !sc.last_piece.empty() ? &sc.last_piece : nullptr;
+  refine_section(hull, p, tol, last != nullptr ? nullptr : cover0, cover1, last, sc);
   sc.support_queries += hull.queries;
   convex_hull(sc.pts, sc.hull);
-  return emit(sc.hull, out, sc.spare);
+  const std::size_t emitted = emit(sc.hull, out, sc.spare);
+  if (bisected && emitted > 0) sc.last_piece.build(sc.hull, cover_margin(tol));
+  else sc.last_piece.clear();
+  return emitted;
 }
 
 // Each sub-step on its own (no covers): every polygon is its sub-step's whole section.

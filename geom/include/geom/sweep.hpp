@@ -39,10 +39,37 @@ struct TiltedPiece;
 
 // Reusable buffers for Sweep::section(); grows to the largest section seen, then stops
 // allocating. One per thread.
+// A point of a section [mm].
+struct SectionPoint {
+  double x, y;
+};
+
+// A convex polygon shrunk by a margin, which tells in O(log n) whether a point lies inside
+// the polygon by at least that margin: what the last tilted piece built on a plane covers
+// for the next one (Sweep::build_piece()). Empty: covers nothing.
+class ConvexCover {
+ public:
+  // From a convex counter-clockwise polygon (mm, as convex_hull() writes it) and the
+  // margin [mm]. Drops vertices closer than a few margins to the last one kept (the rest
+  // spans a subset), then moves every edge inwards by the margin; when an edge would vanish
+  // or turn (an edge too short for the margin), or fewer than 3 are left, the cover is empty.
+  // Allocates only while its buffer grows.
+  void build(const std::vector<SectionPoint>& hull, double margin_mm);
+  void clear() noexcept { v_.clear(); }
+  [[nodiscard]] bool empty() const noexcept { return v_.empty(); }
+  // True when q lies inside the shrunk polygon (so inside the polygon by the margin).
+  [[nodiscard]] bool contains(const SectionPoint& q) const noexcept;
+
+ private:
+  std::vector<SectionPoint> v_;  // the shrunk polygon, counter-clockwise
+  std::vector<SectionPoint> kept_;
+  SectionPoint c_{};  // the mean of v_ (inside it)
+  double x0_ = 0.0, y0_ = 0.0, x1_ = 0.0, y1_ = 0.0;  // v_'s box
+  std::vector<double> ang_;  // pseudo-angles of v_ about c_, increasing
+};
+
 struct SectionScratch {
-  struct P2 {
-    double x, y;
-  };
+  using P2 = SectionPoint;
   std::vector<P2> pts;
   std::vector<P2> hull;
   struct Disk {
@@ -65,6 +92,9 @@ struct SectionScratch {
   // Support queries of the tilted sections' refinement (Sweep::build_piece()) so far; the
   // coarse points' are in TiltedPiece::coarse_queries. A count for tests and profiles.
   std::uint64_t support_queries = 0;
+  // The last tilted piece's polygon as a cover for the next piece on the same plane
+  // (Sweep::build_piece()).
+  ConvexCover last_piece;
   // Set by each vertical section: a capsule inside the polygon just emitted (invalid when
   // the last section was empty or came from the general path).
   Capsule core;
@@ -212,8 +242,12 @@ class Sweep {
   // together with those pieces' own polygons, which contain their coarse polygons. So the
   // polygons of a sequence of pieces, each built with its neighbours as covers, have the
   // union of their sections within the chord tolerance when removed in one difference.
+  // With `after_last`, the polygon that the previous call with this scratch built (a piece
+  // of the same plane, removed in the same difference: the caller's promise) covers too,
+  // refined as it was: the arcs of this piece that lie in it are not refined either. Each
+  // call leaves its own polygon in scratch.last_piece for the next.
   std::size_t build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
-                          SectionScratch& scratch) const;
+                          SectionScratch& scratch, bool after_last = false) const;
 
   static constexpr int kMaxTiltSubsteps = 256;  // sub-steps of one sweep whose tool axis turns (kin::kMaxMoveSubsteps: pieces of a move)
 
