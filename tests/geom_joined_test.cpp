@@ -429,3 +429,31 @@ TEST(TightLoop, BatchesCutAtLoopsRemoveTheExactHelicalBore) {
   EXPECT_NEAR(test::removed(s), exact, 2.0 * perimeter * kTol * 5.0);
   EXPECT_EQ(s.check_invariants(), "");
 }
+
+// ---- geom::tilted_path_end(), geom::batch_end(): a batch's tilted moves run at most
+// kTiltedBatchDiameters tool diameters ----
+
+TEST(TiltedBatch, EndsAfterSixteenDiametersOfTiltedPath) {
+  // Flat Ø10, moves of 1 mm in X: 16 diameters are 160 mm, so the 161st tilted move would
+  // exceed them and the batch ends before it (160 moves). Vertical moves do not count.
+  const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
+  const geom::Vec3 tilted{0.0, std::sin(0.2), std::cos(0.2)};
+  std::vector<geom::SweepRef> moves;
+  for (int i = 0; i < 400; ++i) {
+    const bool vertical = i < 100;  // 100 vertical moves first
+    const geom::Vec3 axis = vertical ? geom::Vec3{0, 0, 1} : tilted;
+    moves.push_back({&c, geom::Pose{{1.0 * i, 0, 0}, axis}, geom::Pose{{1.0 * (i + 1), 0, 0}, axis},
+                     static_cast<geom::MoveId>(i + 1), nullptr});
+  }
+  ASSERT_DOUBLE_EQ(geom::kTiltedBatchDiameters, 16.0);
+  EXPECT_EQ(geom::tilted_path_end(moves), 260u);
+  EXPECT_EQ(geom::batch_end(moves), 260u);  // no tight loop in a straight line
+  EXPECT_EQ(geom::tilted_path_end(std::span<const geom::SweepRef>(moves).first(100)), 100u);  // all vertical
+  // One move longer than the bound on its own still makes a batch of one.
+  const std::vector<geom::SweepRef> long_move{{&c, geom::Pose{{0, 0, 0}, tilted}, geom::Pose{{500, 0, 0}, tilted}, 1, nullptr},
+                                              {&c, geom::Pose{{500, 0, 0}, tilted}, geom::Pose{{501, 0, 0}, tilted}, 2, nullptr}};
+  EXPECT_EQ(geom::tilted_path_end(long_move), 1u);
+  // A tight helix ends the batch first where it closes its turn (tight_loop_end()).
+  const auto helix_moves = refs(c, helix(30, 20, 2, 0, 1, 3, 720));
+  EXPECT_EQ(geom::batch_end(helix_moves), geom::tight_loop_end(helix_moves));
+}

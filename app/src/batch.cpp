@@ -53,12 +53,13 @@ void run_moves(const Profile& profile, const std::vector<motion::TimedSweep>& mo
   const std::size_t per = static_cast<std::size_t>(std::max(1, profile.batch_moves));
   std::size_t begin = 0;
   std::deque<std::size_t> ends;  // where the batches pulled so far end
-  // A batch also ends where its path closes a tight loop (geom::tight_loop_end()).
+  // A batch also ends where its path closes a tight loop or its tilted moves have run long
+  // enough (geom::batch_end()).
   auto cut_loops = [&](std::vector<geom::SweepRef>& out, std::size_t from) {
     if (!std::is_sorted(moves.begin() + static_cast<long>(from), moves.begin() + static_cast<long>(from + out.size()),
                         [](const motion::TimedSweep& a, const motion::TimedSweep& b) { return a.channel < b.channel; }))
       return out.size();  // channels regrouped: several paths, no single loop to cut
-    out.resize(geom::tight_loop_end(out));
+    out.resize(geom::batch_end(out));
     return out.size();
   };
   const geom::ParallelSubtractor::BatchSource source = [&](std::vector<geom::SweepRef>& out) {

@@ -323,4 +323,20 @@ std::size_t tight_loop_end(std::span<const SweepRef> moves) noexcept {
   return moves.size();
 }
 
+std::size_t tilted_path_end(std::span<const SweepRef> moves) noexcept {
+  auto plus_z = [](const Vec3& a) { return a.x == 0.0 && a.y == 0.0 && a.z > 0.0; };
+  double diameters = 0.0;
+  for (std::size_t i = 0; i < moves.size(); ++i) {
+    const SweepRef& m = moves[i];
+    if (m.shape == nullptr || (plus_z(m.from.axis) && plus_z(m.to.axis)) || !(m.shape->radius() > 0.0)) continue;
+    diameters += std::hypot(m.to.tip.x - m.from.tip.x, m.to.tip.y - m.from.tip.y) / (2.0 * m.shape->radius());
+    if (diameters > kTiltedBatchDiameters) return std::max<std::size_t>(i, 1);
+  }
+  return moves.size();
+}
+
+std::size_t batch_end(std::span<const SweepRef> moves) noexcept {
+  return std::min(tight_loop_end(moves), tilted_path_end(moves));
+}
+
 }  // namespace lbr::geom

@@ -279,7 +279,7 @@ bool Geometry::apply(std::span<const geom::SweepRef> batch) noexcept {
     // The checks judge the sub-batch against the stock now; a sweep after the first that
     // meets material ends it (judged again, as the first of the next, once the ones before
     // it are subtracted).
-    j = i + geom::tight_loop_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time
+    j = i + geom::batch_end(batch.subspan(i, j - i));  // one turn of a tight loop at a time, tilted runs bounded
     j = checked(i, j);
     if (j - i - 1 < prefix_units_.size()) part.units = prefix_units_[j - i - 1];  // the sweeps it keeps
     // Timed calls cut a sweep only for its sections (a turning tool axis): every piece

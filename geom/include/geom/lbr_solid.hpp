@@ -102,6 +102,24 @@ struct SweepRef {
 inline constexpr double kTightLoopDiameters = 2.0;
 [[nodiscard]] std::size_t tight_loop_end(std::span<const SweepRef> moves) noexcept;
 
+// Where a batch of `moves` should end so that the tilted milling moves in it (a tool axis
+// other than +Z at either pose: the general sections, geom/sweep.hpp) do not run along more
+// than kTiltedBatchDiameters tool diameters of XY path: the number of leading moves (at
+// least one, at most moves.size()). A raster's neighbouring passes overlap, and a batch that
+// holds many of them feeds each cell's difference all their sections at once (the Vatti
+// sweep's cost grows with the square of the crossing edges), while material that an earlier
+// batch removed lets a later one skip the sub-steps beside it. On LinuxCNC's boat-xyzac
+// (1 853 segments) batches of 512 moves ran 1.42x the time of batches of 32 (about 14
+// diameters); a sampled stream of 512 samples runs about 3 diameters, and smaller batches
+// than that cost more than they save (64 samples: 1.27x). docs/performance.md. Real-time
+// safe.
+inline constexpr double kTiltedBatchDiameters = 16.0;
+[[nodiscard]] std::size_t tilted_path_end(std::span<const SweepRef> moves) noexcept;
+
+// Where a batch of `moves` should end: the first of tight_loop_end() and tilted_path_end().
+// Real-time safe.
+[[nodiscard]] std::size_t batch_end(std::span<const SweepRef> moves) noexcept;
+
 struct SubtractStats {
   std::uint64_t sections = 0;       // section polygons computed
   std::uint64_t cells_tested = 0;   // (region, level) pairs that passed the box tests
