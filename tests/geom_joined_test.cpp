@@ -433,9 +433,10 @@ TEST(TightLoop, BatchesCutAtLoopsRemoveTheExactHelicalBore) {
 // ---- geom::tilted_path_end(), geom::batch_end(): a batch's tilted moves run at most
 // kTiltedBatchDiameters tool diameters ----
 
-TEST(TiltedBatch, EndsAfterSixteenDiametersOfTiltedPath) {
-  // Flat Ø10, moves of 1 mm in X: 16 diameters are 160 mm, so the 161st tilted move would
-  // exceed them and the batch ends before it (160 moves). Vertical moves do not count.
+TEST(TiltedBatch, EndsAfterEightDiametersOfTiltedPath) {
+  // Flat Ø10, moves of 1 mm in X: 8 diameters are 80 mm, so the 81st tilted move would
+  // exceed them and the batch ends before it (after 100 vertical and 80 tilted moves).
+  // Vertical moves do not count.
   const auto c = geom::CutterShape::build(test::tool(ToolKind::Flat, 10), kTol);
   const geom::Vec3 tilted{0.0, std::sin(0.2), std::cos(0.2)};
   std::vector<geom::SweepRef> moves;
@@ -445,9 +446,9 @@ TEST(TiltedBatch, EndsAfterSixteenDiametersOfTiltedPath) {
     moves.push_back({&c, geom::Pose{{1.0 * i, 0, 0}, axis}, geom::Pose{{1.0 * (i + 1), 0, 0}, axis},
                      static_cast<geom::MoveId>(i + 1), nullptr});
   }
-  ASSERT_DOUBLE_EQ(geom::kTiltedBatchDiameters, 16.0);
-  EXPECT_EQ(geom::tilted_path_end(moves), 260u);
-  EXPECT_EQ(geom::batch_end(moves), 260u);  // no tight loop in a straight line
+  ASSERT_DOUBLE_EQ(geom::kTiltedBatchDiameters, 8.0);
+  EXPECT_EQ(geom::tilted_path_end(moves), 180u);
+  EXPECT_EQ(geom::batch_end(moves), 180u);  // no tight loop in a straight line
   EXPECT_EQ(geom::tilted_path_end(std::span<const geom::SweepRef>(moves).first(100)), 100u);  // all vertical
   // One move longer than the bound on its own still makes a batch of one.
   const std::vector<geom::SweepRef> long_move{{&c, geom::Pose{{0, 0, 0}, tilted}, geom::Pose{{500, 0, 0}, tilted}, 1, nullptr},

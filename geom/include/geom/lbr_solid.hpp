@@ -109,11 +109,11 @@ inline constexpr double kTightLoopDiameters = 2.0;
 // holds many of them feeds each cell's difference all their sections at once (the Vatti
 // sweep's cost grows with the square of the crossing edges), while material that an earlier
 // batch removed lets a later one skip the sub-steps beside it. On LinuxCNC's boat-xyzac
-// (1 853 segments) batches of 512 moves ran 1.42x the time of batches of 32 (about 14
-// diameters); a sampled stream of 512 samples runs about 3 diameters, and smaller batches
-// than that cost more than they save (64 samples: 1.27x). docs/performance.md. Real-time
-// safe.
-inline constexpr double kTiltedBatchDiameters = 16.0;
+// (1 853 segments) batches of 512 moves ran 1.42x the time of batches of 32; against 16
+// diameters, 8 ran 0.96x (boat-xyzac) and 0.92x (boat-xyzbc) and 4 ran 1.08x on finish5x.
+// A sampled stream's 512 samples run about 3 diameters, and smaller batches than that cost
+// more than they save (64 samples: 1.27x). docs/performance.md. Real-time safe.
+inline constexpr double kTiltedBatchDiameters = 8.0;
 [[nodiscard]] std::size_t tilted_path_end(std::span<const SweepRef> moves) noexcept;
 
 // Where a batch of `moves` should end: the first of tight_loop_end() and tilted_path_end().
