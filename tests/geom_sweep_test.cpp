@@ -380,12 +380,13 @@ TEST(Sweep, TiltedPiecesWithNeighbourCoversKeepTheUnionWithFewerVertices) {
     }
     ASSERT_EQ(full.size(), pieces.size());
     // The engine's way since: the previous piece's refined polygon covers too
-    // (build_piece's after_last; its own scratch, so that each call follows the one before).
-    geom::SectionScratch sc_last;
+    // (build_piece's last and keep).
+    geom::ConvexCover cover[2];
     geom::Paths after_last;
     for (std::size_t i = 0; i < pieces.size(); ++i)
       sweeps[pieces[i].sweep].build_piece(pieces[i], i > 0 ? &pieces[i - 1] : nullptr,
-                                          i + 1 < pieces.size() ? &pieces[i + 1] : nullptr, after_last, sc_last, i > 0);
+                                          i + 1 < pieces.size() ? &pieces[i + 1] : nullptr, after_last, sc,
+                                          i > 0 ? &cover[(i - 1) % 2] : nullptr, &cover[i % 2]);
     std::size_t vc = 0, vf = 0, vl = 0;
     for (const auto& p : covered) vc += p.size();
     for (const auto& p : full) vf += p.size();

@@ -136,8 +136,7 @@ void merge_collinear(std::span<const SweepRef> batch, std::vector<SweepRef>& out
 namespace {
 
 bool horizontal(const SweepRef& r) noexcept {
-  return r.turning == nullptr && r.shape != nullptr && r.from.tip.z == r.to.tip.z && r.from.axis.x == 0.0 &&
-         r.from.axis.y == 0.0 && r.from.axis.z > 0.0 && r.to.axis.x == 0.0 && r.to.axis.y == 0.0 && r.to.axis.z > 0.0;
+  return r.turning == nullptr && r.shape != nullptr && r.from.tip.z == r.to.tip.z && vertical_poses(r.from, r.to);
 }
 
 // When sh.merged[i] starts a chain (at least three consecutive horizontal moves of one tool
@@ -219,6 +218,7 @@ int interval_of(const std::vector<Coord>& b, Coord v) noexcept {
 
 void SubtractEngine::prepare(std::span<const SweepRef> batch, SubtractShared& sh) const {
   merge_collinear(batch, sh.merged, s_.z_top_mm());
+  reset_level_last();
   double zlo = INFINITY, zhi = -INFINITY;
   plan_moves(sh, s_.z_top_mm(), zlo, zhi);
   const bool nothing =
@@ -324,11 +324,10 @@ std::size_t tight_loop_end(std::span<const SweepRef> moves) noexcept {
 }
 
 std::size_t tilted_path_end(std::span<const SweepRef> moves) noexcept {
-  auto plus_z = [](const Vec3& a) { return a.x == 0.0 && a.y == 0.0 && a.z > 0.0; };
   double diameters = 0.0;
   for (std::size_t i = 0; i < moves.size(); ++i) {
     const SweepRef& m = moves[i];
-    if (m.shape == nullptr || (plus_z(m.from.axis) && plus_z(m.to.axis)) || !(m.shape->radius() > 0.0)) continue;
+    if (m.shape == nullptr || vertical_poses(m.from, m.to) || !(m.shape->radius() > 0.0)) continue;
     diameters += std::hypot(m.to.tip.x - m.from.tip.x, m.to.tip.y - m.from.tip.y) / (2.0 * m.shape->radius());
     if (diameters > kTiltedBatchDiameters) return std::max<std::size_t>(i, 1);
   }

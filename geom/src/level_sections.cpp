@@ -301,13 +301,14 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
   const std::size_t n = ws.pieces.size();
   if (n == 0) return;
   const std::size_t level = static_cast<std::size_t>(s_.level_at(ws.pieces.front().zc));
-  const TiltedPiece* prior = level_prior(level, ws);
+  const TiltedPiece* prior = level_prior(level);
   MoveId id = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const TiltedPiece& p = ws.pieces[i];
     const std::size_t before = ls.paths.size();
     sh.sweeps[p.sweep].build_piece(p, i > 0 ? &ws.pieces[i - 1] : prior, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
-                                   ls.paths, ws.scratch, i > 0);
+                                   ls.paths, ws.scratch, i > 0 ? &ws.piece_cover[(i - 1) % 2] : nullptr,
+                                   i + 1 < n ? &ws.piece_cover[i % 2] : nullptr);
     if (ls.paths.size() > before) id = std::max(id, sh.sweep_id[p.sweep]);
     if (ls.paths.size() - ls.box.size() >= kTiltedGroup) {
       join_tilted(ls.box.size(), id, ws, ls, stats);
@@ -315,24 +316,34 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
     }
   }
   if (ls.paths.size() > ls.box.size()) join_tilted(ls.box.size(), id, ws, ls, stats);
-  ws.level_last[level] = ws.pieces.back();
-  ws.level_last_set[level] = 1;
+  SubtractWorkspace& kept = *s_.ws_;  // the solid's: the same whichever thread builds the level
+  kept.level_last[level] = ws.pieces.back();
+  kept.level_last_set[level] = 1;
   ws.pieces.clear();
 }
 
-// The last tilted piece this workspace built on `level`, when the solid has
-// not had material put back since (LbrSolid::removal_epoch()): its coarse polygon lies in
-// material already removed, or removed in this difference, so the level's next piece need
-// not refine its boundary where a refinement triangle lies in it (Sweep::build_piece()).
-// A live call holds one or two pieces per level, which had no cover before their first.
-const TiltedPiece* SubtractEngine::level_prior(std::size_t level, SubtractWorkspace& ws) const {
+// The last tilted piece built on `level` for this solid (by whichever thread built the level:
+// kept in the solid's own workspace, so that the result is the same for every thread count),
+// when the solid has not had material put back since (LbrSolid::removal_epoch()): its
+// coarse polygon lies in material already removed, or removed in this difference, so the
+// level's next piece need not refine its boundary where a refinement triangle lies in it
+// (Sweep::build_piece()). A live call holds one or two pieces per level, which had no cover
+// before their first. Until 2026-12-01 each thread kept its own, and a level's first piece
+// of a batch saw the cover of whichever thread had built that level last: finish5x with
+// two threads gave one of two results.
+void SubtractEngine::reset_level_last() const {
+  SubtractWorkspace& kept = *s_.ws_;
   const std::size_t levels = static_cast<std::size_t>(s_.levels());
-  if (ws.level_last_epoch != s_.removal_epoch() || ws.level_last.size() != levels) {
-    ws.level_last.resize(levels);
-    ws.level_last_set.assign(levels, 0);
-    ws.level_last_epoch = s_.removal_epoch();
+  if (kept.level_last_epoch != s_.removal_epoch() || kept.level_last.size() != levels) {
+    kept.level_last.resize(levels);
+    kept.level_last_set.assign(levels, 0);
+    kept.level_last_epoch = s_.removal_epoch();
   }
-  return ws.level_last_set[level] != 0 ? &ws.level_last[level] : nullptr;
+}
+
+const TiltedPiece* SubtractEngine::level_prior(std::size_t level) const {
+  const SubtractWorkspace& kept = *s_.ws_;
+  return kept.level_last_set[level] != 0 ? &kept.level_last[level] : nullptr;
 }
 
 // The tilted sections ls.paths[begin..] (consecutive sub-steps and moves of one run, each

@@ -57,7 +57,11 @@ class SubtractEngine {
   void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const Rect& material,
                           const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   void build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
-  const TiltedPiece* level_prior(std::size_t level, SubtractWorkspace& ws) const;
+  // The solid's last tilted piece per level (the solid's own workspace's level_last):
+  // sized and reset on the preparing thread (reset_level_last(), from prepare()), then read
+  // and written per level by the one thread that builds that level.
+  void reset_level_last() const;
+  [[nodiscard]] const TiltedPiece* level_prior(std::size_t level) const;
   static void join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats);
   static void add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls);
   void add_lathe_sections(double zc, const SubtractShared& sh, LevelSections& ls) const;

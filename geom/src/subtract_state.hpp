@@ -136,9 +136,11 @@ struct SubtractWorkspace {
   std::vector<SectionScratch::P2> outline;    // a joined run's vertices before rounding
   Path cut, cut_tmp;                          // a long section cut to a region
   std::vector<TiltedPiece> pieces;            // a run's tilted sub-steps on one level, pending
-  // Per level, the last tilted piece this workspace built there, while the solid's
-  // removal_epoch() is level_last_epoch: its coarse polygon lies in material already removed
-  // (or removed in the same difference), so it covers the next piece there (build_tilted()).
+  ConvexCover piece_cover[2];                 // pieces[i]'s polygon in [i % 2], for pieces[i + 1]
+  // Per level, the last tilted piece built there for the solid, while its removal_epoch() is
+  // level_last_epoch: its coarse polygon lies in material already removed (or removed in the
+  // same difference), so it covers the next piece there (build_tilted()). Only the solid's
+  // own workspace (LbrSolid::ws_) holds them, whichever thread builds the level.
   std::vector<TiltedPiece> level_last;
   std::vector<std::uint8_t> level_last_set;
   std::uint64_t level_last_epoch = 0;

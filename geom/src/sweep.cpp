@@ -23,7 +23,6 @@ namespace {
 
 using P2 = SectionScratch::P2;
 
-bool is_plus_z(const Vec3& a) noexcept { return a.x == 0.0 && a.y == 0.0 && a.z > 0.0; }
 
 Vec3 normalized(Vec3 v) noexcept {
   const double n = norm(v);
@@ -626,7 +625,7 @@ Sweep::Sweep(const CutterShape& shape, const Pose& from, const Pose& to, double 
     : shape_(&shape), from_(from), to_(to) {
   from_.axis = normalized(from_.axis);
   to_.axis = normalized(to_.axis);
-  vertical_ = is_plus_z(from.axis) && is_plus_z(to.axis);
+  vertical_ = vertical_poses(from, to);
   const double R = shape.radius(), H = shape.height();
   if (vertical_) {
     box_.add({from.tip.x - R, from.tip.y - R, from.tip.z});
@@ -1197,6 +1196,13 @@ bool beside_material(const Hull3& hull, const Circle* c, int n, const Rect& m) n
 }
 
 
+// A pseudo-angle of (dx, dy) in [0, 4): increasing with the angle from +x counter-clockwise.
+double pseudo_angle(double dx, double dy) noexcept {
+  const double s = std::abs(dx) + std::abs(dy);
+  if (!(s > 0.0)) return 0.0;
+  return dy >= 0.0 ? 1.0 - dx / s : 3.0 + dx / s;
+}
+
 // The coarse points of piece p (its kDirs directions) and Q's half-planes. Each direction's
 // search starts from the previous piece's final bracket in the same direction when there is
 // one (`prev`: the sub-step before on the same plane, whose tilt there differs little), else
@@ -1261,15 +1267,6 @@ void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, cons
 
 }  // namespace
 
-namespace {
-// A pseudo-angle of (dx, dy) in [0, 4): increasing with the angle from +x counter-clockwise.
-double pseudo_angle(double dx, double dy) noexcept {
-  const double s = std::abs(dx) + std::abs(dy);
-  if (!(s > 0.0)) return 0.0;
-  return dy >= 0.0 ? 1.0 - dx / s : 3.0 + dx / s;
-}
-}  // namespace
-
 void ConvexCover::build(const std::vector<SectionPoint>& hull, double margin_mm) {
   v_.clear();
   kept_.clear();
@@ -1327,9 +1324,10 @@ void ConvexCover::build(const std::vector<SectionPoint>& hull, double margin_mm)
   }
   std::rotate(v_.begin(), v_.begin() + static_cast<std::ptrdiff_t>(first), v_.end());
   std::rotate(ang_.begin(), ang_.begin() + static_cast<std::ptrdiff_t>(first), ang_.end());
-  if (!std::is_sorted(ang_.begin(), ang_.end())) v_.clear();  // not star-shaped about c_ in angle order: cannot be
+  // A convex polygon is in angle order about any point inside it; rounding near c_ could
+  // still break the order, and then the bisection would be wrong: no cover.
+  if (!std::is_sorted(ang_.begin(), ang_.end())) v_.clear();
 }
-
 
 // The wedge at the mean point between rays to v_k and v_k+1 that holds q (bisection on
 // the vertices' pseudo-angles), then q against the edge v_k v_k+1.
@@ -1396,21 +1394,19 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
 }
 
 std::size_t Sweep::build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
-                               SectionScratch& sc, bool after_last) const {
+                               SectionScratch& sc, const ConvexCover* last, ConvexCover* keep) const {
   const Hull3 hull(shape_, p.a, p.b, top_);
   const double tol = shape_->chord_tol_mm;
-  // The capsule's boundary points are closed forms, about as cheap as a test against the
-  // last polygon: it keeps only the coarse covers. The last polygon, the previous piece's,
-  // holds that piece's coarse polygon, so it stands in for cover0 (the caller's previous
-  // piece) when there is one.
   const bool bisected = !(shape_->capsule_radius_mm > 0.0 && shape_->core_radius_mm == 0.0);
-  const ConvexCover* last = bisected && after_last && !sc.last_piece.empty() ? &sc.last_piece : nullptr;
+  if (!bisected || (last != nullptr && last->empty())) last = nullptr;
   refine_section(hull, p, tol, last != nullptr ? nullptr : cover0, cover1, last, sc);
   sc.support_queries += hull.queries;
   convex_hull(sc.pts, sc.hull);
   const std::size_t emitted = emit(sc.hull, out, sc.spare);
-  if (bisected && emitted > 0) sc.last_piece.build(sc.hull, cover_margin(tol));
-  else sc.last_piece.clear();
+  if (keep != nullptr) {
+    if (bisected && emitted > 0) keep->build(sc.hull, cover_margin(tol));
+    else keep->clear();
+  }
   return emitted;
 }
 

@@ -37,8 +37,6 @@ struct Capsule {
 
 struct TiltedPiece;
 
-// Reusable buffers for Sweep::section(); grows to the largest section seen, then stops
-// allocating. One per thread.
 // A point of a section [mm].
 struct SectionPoint {
   double x, y;
@@ -68,6 +66,8 @@ class ConvexCover {
   std::vector<double> ang_;  // pseudo-angles of v_ about c_, increasing
 };
 
+// Reusable buffers for Sweep::section(); grows to the largest section seen, then stops
+// allocating. One per thread.
 struct SectionScratch {
   using P2 = SectionPoint;
   std::vector<P2> pts;
@@ -92,9 +92,6 @@ struct SectionScratch {
   // Support queries of the tilted sections' refinement (Sweep::build_piece()) so far; the
   // coarse points' are in TiltedPiece::coarse_queries. A count for tests and profiles.
   std::uint64_t support_queries = 0;
-  // The last tilted piece's polygon as a cover for the next piece on the same plane
-  // (Sweep::build_piece()).
-  ConvexCover last_piece;
   // Set by each vertical section: a capsule inside the polygon just emitted (invalid when
   // the last section was empty or came from the general path).
   Capsule core;
@@ -242,12 +239,14 @@ class Sweep {
   // together with those pieces' own polygons, which contain their coarse polygons. So the
   // polygons of a sequence of pieces, each built with its neighbours as covers, have the
   // union of their sections within the chord tolerance when removed in one difference.
-  // With `after_last`, the polygon that the previous call with this scratch built (a piece
-  // of the same plane, removed in the same difference: the caller's promise) covers too,
-  // refined as it was: the arcs of this piece that lie in it are not refined either. Each
-  // call leaves its own polygon in scratch.last_piece for the next.
+  // `last`, when given, is the polygon that cover0's piece built (kept by its call in `keep`;
+  // removed in the same difference: the caller's promise). It covers refined as it was, so
+  // it stands in for cover0's coarse polygon, which it contains. `keep`, when given, takes
+  // this piece's polygon for the next piece (emptied when there is none). Models whose
+  // boundary points are closed forms (the capsule) ignore both: a test costs as much as the
+  // point.
   std::size_t build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
-                          SectionScratch& scratch, bool after_last = false) const;
+                          SectionScratch& scratch, const ConvexCover* last = nullptr, ConvexCover* keep = nullptr) const;
 
   static constexpr int kMaxTiltSubsteps = 256;  // sub-steps of one sweep whose tool axis turns (kin::kMaxMoveSubsteps: pieces of a move)
 

@@ -42,6 +42,11 @@ struct Pose {
   Vec3 axis{0, 0, 1};
 };
 
+// True when both poses' axes are exactly +Z: geom::Sweep's 3-axis (vertical) sweep.
+[[nodiscard]] inline bool vertical_poses(const Pose& a, const Pose& b) noexcept {
+  return a.axis.x == 0.0 && a.axis.y == 0.0 && a.axis.z > 0.0 && b.axis.x == 0.0 && b.axis.y == 0.0 && b.axis.z > 0.0;
+}
+
 // How far the tool at pose p lies from the sweep a→b (tip along the segment, axis
 // normalized(lerp(a.axis, b.axis, t)), as geom::Sweep moves it) [mm]: at the parameter t where
 // p's tip projects onto the segment, the tips' distance plus reach_mm times the angle between
