@@ -221,6 +221,7 @@ void SubtractEngine::prepare(std::span<const SweepRef> batch, SubtractShared& sh
   reset_level_last();
   double zlo = INFINITY, zhi = -INFINITY;
   plan_moves(sh, s_.z_top_mm(), zlo, zhi);
+  reset_cell_masks(std::any_of(sh.sweeps.begin(), sh.sweeps.end(), [](const Sweep& w) { return !w.vertical(); }));
   const bool nothing =
       (sh.sweeps.empty() && sh.lathe.empty() && sh.chain_count == 0) || zhi < s_.z0_ || zlo > s_.z1_;
   sh.lb = nothing ? 0 : s_.level_at(zlo);

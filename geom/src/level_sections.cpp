@@ -64,10 +64,10 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
-  // The material of this level before the batch (the cells' boxes): tilted sub-steps beside
-  // it are not built (Sweep::section()).
-  Rect material;
-  for (int r = 0; r < s_.regions(); ++r) material.add(s_.cell(r, level).bbox);
+  // The material of this level before the batch (the cells' boxes and masks): tilted
+  // sub-steps beside it are not built, and pieces whose sections miss it are marked in_air
+  // (Sweep::tilted_pieces()).
+  const LevelMaterial material(s_, level, s_.xs_, s_.ys_, s_.ws_->masks, ws.mask_crossings);
   for (const auto& run : sh.runs) build_run_sections(zc, run, material, sh, ws, ls, stats);
   ls.chain.assign(ls.paths.size(), kNoChain);
   ls.reach_begin.resize(ls.paths.size(), kNoReach);  // tilted sections: none
@@ -196,7 +196,7 @@ bool still_beside_outline(double zc, std::uint32_t si, std::uint32_t end, bool a
 // The sections of one run of sweeps on plane zc: consecutive moves whose sections share
 // their joint disk become one outline (chain_outline.hpp); the others are emitted one by
 // one, trimmed where the previous vertical section covers them (trim_covered()).
-void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const Rect& material,
+void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const PlaneMaterial& material,
                                         const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                                         SubtractStats& stats) const {
   Capsule prev_core;  // inside the last single vertical section of this run (trim_covered())
@@ -305,6 +305,11 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
   MoveId id = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const TiltedPiece& p = ws.pieces[i];
+    if (p.in_air) {  // its section would remove nothing; what it covers for its neighbours is air too
+      ++stats.tilted_in_air;
+      ws.piece_cover[i % 2].clear();  // no polygon built: the next piece has no such cover
+      continue;
+    }
     const std::size_t before = ls.paths.size();
     sh.sweeps[p.sweep].build_piece(p, i > 0 ? &ws.pieces[i - 1] : prior, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
                                    ls.paths, ws.scratch, i > 0 ? &ws.piece_cover[(i - 1) % 2] : nullptr,
@@ -339,6 +344,15 @@ void SubtractEngine::reset_level_last() const {
     kept.level_last_set.assign(levels, 0);
     kept.level_last_epoch = s_.removal_epoch();
   }
+}
+
+void SubtractEngine::reset_cell_masks(bool tilted) const {
+  SubtractWorkspace& kept = *s_.ws_;
+  if (kept.masks_epoch != s_.removal_epoch()) {
+    for (CellMask& m : kept.masks) m.built = false;
+    kept.masks_epoch = s_.removal_epoch();
+  }
+  if (tilted && kept.masks.size() != s_.cells_.size()) kept.masks.assign(s_.cells_.size(), CellMask{});
 }
 
 const TiltedPiece* SubtractEngine::level_prior(std::size_t level) const {

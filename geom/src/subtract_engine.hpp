@@ -54,13 +54,16 @@ class SubtractEngine {
   // --- level_sections.cpp ---
   void build_level(int level, const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
                    SubtractStats& stats) const;
-  void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const Rect& material,
+  void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const PlaneMaterial& material,
                           const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   void build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
   // The solid's last tilted piece per level (the solid's own workspace's level_last):
   // sized and reset on the preparing thread (reset_level_last(), from prepare()), then read
   // and written per level by the one thread that builds that level.
   void reset_level_last() const;
+  // The solid's cell masks (SubtractWorkspace::masks), sized when `tilted` (the batch has a
+  // tilted sweep) and forgotten when material was put back; on the preparing thread.
+  void reset_cell_masks(bool tilted) const;
   [[nodiscard]] const TiltedPiece* level_prior(std::size_t level) const;
   static void join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats);
   static void add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls);

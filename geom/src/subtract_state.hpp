@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "clip_reach.hpp"
+#include "material_mask.hpp"
 #include "monotone_union.hpp"
 #include "window_clip.hpp"
 #include "geom/lbr_solid.hpp"
@@ -144,6 +145,13 @@ struct SubtractWorkspace {
   std::vector<TiltedPiece> level_last;
   std::vector<std::uint8_t> level_last_set;
   std::uint64_t level_last_epoch = 0;
+  // Per cell (region * levels + level), its material as a raster, built when a tilted piece
+  // first asks after the cell changed (LevelMaterial); sized on the first batch
+  // with a tilted sweep and reset with the removal epoch. Only the solid's own workspace
+  // holds them; a cell is read and built by the one thread that builds its level.
+  std::vector<CellMask> masks;
+  std::uint64_t masks_epoch = 0;
+  std::vector<std::pair<int, double>> mask_crossings;  // CellMask::build()'s buffer
   MonotoneUnion joined;                       // joins consecutive tilted sections (join_tilted())
   Paths join_in;                              // the sections being joined
   std::vector<std::uint8_t> trim_flags;

@@ -66,6 +66,22 @@ class ConvexCover {
   std::vector<double> ang_;  // pseudo-angles of v_ about c_, increasing
 };
 
+// What a tilted sweep's section may remove on one plane (Sweep::tilted_pieces()): the box of
+// the material there [kernel units] and a finer test of a convex polygon against it.
+class PlaneMaterial {
+ public:
+  Rect box;
+  // False only when no material lies inside convex polygon `poly` [mm, counter-clockwise]:
+  // a section inside it would remove nothing. May build the caller's caches (allocates).
+  [[nodiscard]] virtual bool may_meet(std::span<const SectionPoint> poly) const = 0;
+
+ protected:
+  PlaneMaterial() = default;
+  PlaneMaterial(const PlaneMaterial&) = default;
+  PlaneMaterial& operator=(const PlaneMaterial&) = default;
+  ~PlaneMaterial() = default;
+};
+
 // Reusable buffers for Sweep::section(); grows to the largest section seen, then stops
 // allocating. One per thread.
 struct SectionScratch {
@@ -87,6 +103,7 @@ struct SectionScratch {
     P2 u;  // the in-plane direction (cos φ, sin φ)
     P2 p;  // the section's boundary point in direction u
     double t_lo, t_hi;  // the bracket of the 3D direction's tilt that found p
+    double h;  // a proven bound on the section's support value: it lies in u·x <= h [mm]
   };
   std::vector<TiltedPiece> pieces;  // a tilted sweep's sub-steps on the plane (section())
   // Support queries of the tilted sections' refinement (Sweep::build_piece()) so far; the
@@ -154,7 +171,16 @@ struct TiltedPiece {
   // A disk inside Q and one around it, both about the mean of Q's points [mm]: most points
   // are decided by one of them without Q's edges.
   double cx = 0, cy = 0, r_in = 0, r_out2 = 0;
+  // Its section meets no material (Sweep::tilted_pieces()'s PlaneMaterial): it is not built,
+  // and its coarse points may be only those of the axis directions (then edge_count is 0).
+  bool in_air = false;
   [[nodiscard]] bool covers(const SectionScratch::P2& p, double margin_mm) const noexcept;
+  // The polygon of its coarse directions' proven bounds (Dir::h), each moved out by a kernel
+  // unit, into `out` (counter-clockwise): the section lies inside it. Directions `step`
+  // apart only (1: all, kDirs / 4: the axes' box). Returns its vertex count, 0 when the
+  // bounds leave nothing.
+  static constexpr int kMaxOuter = 4 + kDirs;  // a box cut by kDirs half-planes
+  int outer_polygon(int step, SectionScratch::P2 (&out)[kMaxOuter]) const noexcept;
 };
 
 // Removes from convex polygon `b` (counter-clockwise, kernel units) the vertices that lie
@@ -197,11 +223,11 @@ class Sweep {
   // Appends the section on plane z = z_mm as convex polygons (counter-clockwise, kernel
   // units) to out; returns how many were appended. `scratch` is reused between calls to
   // avoid allocation once it has grown. Real-time safe once the buffers have grown.
-  // `material`, when given, bounds what the section may remove on this plane (the box of
-  // the material there, kernel units): a tilted sub-step whose swept hull lies wholly beside
-  // it (its box, or one horizontal direction that separates the two) is not built, as its
-  // section would remove nothing.
-  std::size_t section(double z_mm, Paths& out, SectionScratch& scratch, const Rect* material = nullptr) const;
+  // `material`, when given, is what the section may remove on this plane: a tilted sub-step
+  // whose swept hull lies wholly beside its box (the boxes, or one horizontal direction that
+  // separates the two), or whose section's outer polygon it does not meet, is not built, as
+  // its section would remove nothing.
+  std::size_t section(double z_mm, Paths& out, SectionScratch& scratch, const PlaneMaterial* material = nullptr) const;
 
   // Circles become regular n-gons that deviate from them on both sides, so that they carry no
   // bias (docs/lbr-conventions.md, "Tolerances"): vertices on radius r·g, outside the circle
@@ -228,9 +254,12 @@ class Sweep {
   [[nodiscard]] double widest_disk_mm(double z_mm, SectionScratch& scratch) const;
 
   // Tilted sweeps only: appends to `out` one TiltedPiece per sub-step whose hull meets plane
-  // z = z_mm and, when `material` is given, does not lie beside it (as section()); returns
-  // how many. Real-time safe once `out` has grown.
-  std::size_t tilted_pieces(double z_mm, std::vector<TiltedPiece>& out, const Rect* material = nullptr) const;
+  // z = z_mm and, when `material` is given, does not lie beside its box (as section());
+  // returns how many. A piece whose section's outer polygon does not meet `material` is
+  // marked in_air; the box of its axis directions' bounds is tried first, and a piece that
+  // box already clears has only those coarse points. Real-time safe once `out` has grown
+  // and when `material` is (or is null).
+  std::size_t tilted_pieces(double z_mm, std::vector<TiltedPiece>& out, const PlaneMaterial* material = nullptr) const;
   // The section of piece `p` as one convex polygon appended to `out` (counter-clockwise,
   // kernel units); returns 1, or 0 when it has no area. Its boundary is refined to the chord
   // tolerance except on arcs whose refinement triangle (docs/lbr-conventions.md, "Sweeps and
@@ -252,7 +281,7 @@ class Sweep {
 
  private:
   std::size_t section_vertical(double z_mm, Paths& out, SectionScratch& scratch) const;
-  std::size_t section_general(double z_mm, Paths& out, SectionScratch& scratch, const Rect* material) const;
+  std::size_t section_general(double z_mm, Paths& out, SectionScratch& scratch, const PlaneMaterial* material) const;
   // The hull of sc.disks on the n-grid in sc.hull (with hull_role, hull_grid); ends_only keeps
   // only the first and last vertex of each run of directions one end disk wins.
   void ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<SectionScratch::P2>& uc, bool ends_only) const;

@@ -1,0 +1,179 @@
+// A cell's material as a conservative raster, and a tilted piece's outer polygon
+// (material_mask.hpp).
+#include "material_mask.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "geom/units.hpp"
+
+namespace lbr::geom::detail {
+
+namespace {
+
+constexpr int kLast = CellMask::kSide - 1;
+
+// Bits c0..c1 of a row (0 <= c0 <= c1 <= kLast).
+std::uint64_t span_bits(int c0, int c1) noexcept {
+  const std::uint64_t upto = c1 >= kLast ? ~std::uint64_t{0} : (std::uint64_t{1} << (c1 + 1)) - 1;
+  return upto & ~((std::uint64_t{1} << c0) - 1);
+}
+
+int clamp_pixel(double v) noexcept {
+  if (!(v >= 0.0)) return 0;  // NaN too
+  return v >= kLast ? kLast : static_cast<int>(v);
+}
+
+// The x-range of segment a-b within the band y in [lo, hi] (false when it misses the band).
+bool band_range(double ax, double ay, double bx, double by, double lo, double hi, double& xmin, double& xmax) noexcept {
+  if ((ay < lo && by < lo) || (ay > hi && by > hi)) return false;
+  double t0 = 0.0, t1 = 1.0;
+  const double dy = by - ay;
+  if (dy != 0.0) {
+    double ta = (lo - ay) / dy, tb = (hi - ay) / dy;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  const double xa = ax + t0 * (bx - ax), xb = ax + t1 * (bx - ax);
+  xmin = std::min(xa, xb);
+  xmax = std::max(xa, xb);
+  return true;
+}
+
+}  // namespace
+
+double CellMask::px(double x_mm) const noexcept { return (x_mm * kUnitsPerMm - x0_) * sx_; }
+double CellMask::py(double y_mm) const noexcept { return (y_mm * kUnitsPerMm - y0_) * sy_; }
+
+// The pixels the edge passes through, row by row (pixel coordinates), widened by kEdgePad.
+void CellMask::mark_edge(double ax, double ay, double bx, double by) noexcept {
+  const int r0 = clamp_pixel(std::min(ay, by) - kEdgePad), r1 = clamp_pixel(std::max(ay, by) + kEdgePad);
+  for (int r = r0; r <= r1; ++r) {
+    double xmin = 0.0, xmax = 0.0;
+    if (!band_range(ax, ay, bx, by, r - kEdgePad, r + 1 + kEdgePad, xmin, xmax)) continue;
+    rows_[r] |= span_bits(clamp_pixel(xmin - kEdgePad), clamp_pixel(xmax + kEdgePad));
+  }
+}
+
+// Sets the pixels whose centres lie between pairs of a row's crossings (sorted by row, x).
+// Closed contours cross a row an even number of times; a row with an odd count (which
+// rounding cannot make, but a caller's broken cell might) is set whole.
+void CellMask::fill_rows(std::vector<std::pair<int, double>>& crossings) noexcept {
+  std::sort(crossings.begin(), crossings.end());
+  std::size_t i = 0;
+  while (i < crossings.size()) {
+    const int r = crossings[i].first;
+    std::size_t j = i;
+    while (j < crossings.size() && crossings[j].first == r) ++j;
+    if ((j - i) % 2 != 0) rows_[r] = ~std::uint64_t{0};
+    for (std::size_t k = i; k + 1 < j && (j - i) % 2 == 0; k += 2) {
+      // Centres c + 0.5 in [x_k, x_k+1].
+      const double c0 = std::ceil(crossings[k].second - 0.5), c1 = std::floor(crossings[k + 1].second - 0.5);
+      if (c1 < 0.0 || c0 > kLast || c0 > c1) continue;
+      rows_[r] |= span_bits(clamp_pixel(c0), clamp_pixel(c1));
+    }
+    i = j;
+  }
+}
+
+void CellMask::build(const Cell& cell, const Rect& region, std::vector<std::pair<int, double>>& crossings) {
+  std::fill(std::begin(rows_), std::end(rows_), std::uint64_t{0});
+  version = cell.version;
+  built = true;
+  x0_ = static_cast<double>(region.x0);
+  y0_ = static_cast<double>(region.y0);
+  sx_ = kSide / std::max(1.0, static_cast<double>(region.x1 - region.x0));
+  sy_ = kSide / std::max(1.0, static_cast<double>(region.y1 - region.y0));
+  crossings.clear();
+  auto contour = [&](const Path& pts) {
+    const std::size_t n = pts.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point& a = pts[i];
+      const Point& b = pts[i + 1 == n ? 0 : i + 1];
+      const double ax = (static_cast<double>(a.X) - x0_) * sx_, ay = (static_cast<double>(a.Y) - y0_) * sy_;
+      const double bx = (static_cast<double>(b.X) - x0_) * sx_, by = (static_cast<double>(b.Y) - y0_) * sy_;
+      mark_edge(ax, ay, bx, by);
+      // Crossings of the row centres y = r + 0.5 with ay <= y < by (or by <= y < ay).
+      const double lo = std::min(ay, by), hi = std::max(ay, by);
+      const int r0 = std::max(0, static_cast<int>(std::ceil(lo - 0.5))), r1 = std::min(kLast, static_cast<int>(std::ceil(hi - 0.5)) - 1);
+      for (int r = r0; r <= r1; ++r) {
+        const double yc = r + 0.5;
+        crossings.emplace_back(r, ax + (yc - ay) * (bx - ax) / (by - ay));
+      }
+    }
+  };
+  for (const Polygon& p : cell.polys) {
+    contour(p.outer.pts);
+    for (const Contour& h : p.holes) contour(h.pts);
+  }
+  fill_rows(crossings);
+}
+
+bool CellMask::may_meet(std::span<const SectionPoint> poly) const noexcept {
+  if (poly.size() < 3) return true;
+  double ylo = INFINITY, yhi = -INFINITY, xlo = INFINITY, xhi = -INFINITY;
+  for (const SectionPoint& q : poly) {
+    xlo = std::min(xlo, px(q.x));
+    xhi = std::max(xhi, px(q.x));
+    ylo = std::min(ylo, py(q.y));
+    yhi = std::max(yhi, py(q.y));
+  }
+  if (xhi < 0.0 || yhi < 0.0 || xlo > kSide || ylo > kSide) return false;
+  const std::uint64_t box = span_bits(clamp_pixel(xlo), clamp_pixel(xhi));
+  const int r0 = clamp_pixel(ylo), r1 = clamp_pixel(yhi);
+  for (int r = r0; r <= r1; ++r) {
+    if ((rows_[r] & box) == 0) continue;
+    // The polygon's own x-range in this row (convex: its clipped edges' ends).
+    double xmin = INFINITY, xmax = -INFINITY;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const SectionPoint& a = poly[i];
+      const SectionPoint& b = poly[i + 1 == poly.size() ? 0 : i + 1];
+      double e0 = 0.0, e1 = 0.0;
+      if (!band_range(px(a.x), py(a.y), px(b.x), py(b.y), r, r + 1, e0, e1)) continue;
+      xmin = std::min(xmin, e0);
+      xmax = std::max(xmax, e1);
+    }
+    if (xmin > xmax || xmax < 0.0 || xmin > kSide) continue;
+    if ((rows_[r] & span_bits(clamp_pixel(xmin), clamp_pixel(xmax))) != 0) return true;
+  }
+  return false;
+}
+
+LevelMaterial::LevelMaterial(const LbrSolid& solid, int level, std::span<const Coord> xs, std::span<const Coord> ys,
+                             std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings) noexcept
+    : s_(solid), level_(level), xs_(xs), ys_(ys), masks_(masks), crossings_(crossings) {
+  for (int r = 0; r < solid.regions(); ++r) box.add(solid.cell(r, level).bbox);
+}
+
+bool LevelMaterial::may_meet(std::span<const SectionPoint> poly) const {
+  if (masks_.size() != s_.cell_count()) return true;
+  Rect pb;  // the polygon's box [units], rounded outwards
+  for (const SectionPoint& q : poly) {
+    pb.add(Point{static_cast<Coord>(std::floor(q.x * kUnitsPerMm)), static_cast<Coord>(std::floor(q.y * kUnitsPerMm))});
+    pb.add(Point{static_cast<Coord>(std::ceil(q.x * kUnitsPerMm)), static_cast<Coord>(std::ceil(q.y * kUnitsPerMm))});
+  }
+  if (!pb.intersects(box)) return false;
+  // The regions whose rectangles the box reaches (borders ascending; a box that starts on a
+  // border reaches the region before it too).
+  auto first = [](std::span<const Coord> b, Coord v) {
+    const auto it = std::upper_bound(b.begin() + 1, b.end() - 1, v);
+    return static_cast<int>(it - b.begin()) - 1;
+  };
+  const int ix0 = first(xs_, pb.x0 - 1), ix1 = first(xs_, pb.x1);
+  const int iy0 = first(ys_, pb.y0 - 1), iy1 = first(ys_, pb.y1);
+  const auto levels = static_cast<std::size_t>(s_.levels());
+  for (int iy = iy0; iy <= iy1; ++iy)
+    for (int ix = ix0; ix <= ix1; ++ix) {
+      const int region = iy * s_.regions_x() + ix;
+      const Cell& c = s_.cell(region, level_);
+      if (!c.bbox.intersects(pb)) continue;
+      CellMask& m = masks_[static_cast<std::size_t>(region) * levels + static_cast<std::size_t>(level_)];
+      if (!m.built || m.version != c.version) m.build(c, s_.region_rect(region), crossings_);
+      if (m.may_meet(poly)) return true;
+    }
+  return false;
+}
+
+}  // namespace lbr::geom::detail
