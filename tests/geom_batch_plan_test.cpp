@@ -47,11 +47,24 @@ double sampled_reach_below(const geom::CutterShape& c, const geom::Pose& p, doub
   return best;
 }
 
+// The fraction along sweep s at which pose p lies on it (tip and axis as geom::Sweep moves
+// them), or a negative value when it does not lie on s.
+double fraction_on(const geom::SweepRef& s, const geom::Pose& p) {
+  const geom::Vec3 d = s.to.tip - s.from.tip;
+  const double f = geom::dot(p.tip - s.from.tip, d) / geom::dot(d, d);
+  if (f < -1e-12 || f > 1.0 + 1e-12) return -1.0;
+  const geom::Vec3 ax = geom::lerp(s.from.axis, s.to.axis, f);
+  const bool on = geom::norm(p.tip - geom::lerp(s.from.tip, s.to.tip, f)) < 1e-9 &&
+                  geom::norm(p.axis - (1.0 / geom::norm(ax)) * ax) < 1e-9;
+  return on ? f : -1.0;
+}
+
 TEST(BatchPlan, TiltedRunsMergeByThePartOfTheToolBelowTheTop) {
   // With the whole tool's reach (30 mm) the axis may turn only by about tol/2 / 30 mm
   // between a merged sweep and its poses; with the solid's top 2–3 mm above the tip, by
   // ten times that. Every pose of a merged run stays within tol/2 of the merged sweep by
-  // the reach sampled on the tool's surface below the top.
+  // the reach sampled on the tool's surface below the top. A run ends where the tolerance
+  // ends it, inside a move: its end lies on that move, and the next run starts there.
   const auto c = geom::CutterShape::build(test::tool(ToolKind::Ball, 6), kTol);
   const auto run = tilting_run(c, 80);
   std::vector<geom::SweepRef> whole, below;
@@ -60,18 +73,31 @@ TEST(BatchPlan, TiltedRunsMergeByThePartOfTheToolBelowTheTop) {
   geom::detail::merge_collinear(run, below, z_top);
   std::printf("%zu moves: %zu merged sweeps with the whole tool, %zu with its part below the top\n", run.size(),
               whole.size(), below.size());
-  EXPECT_LT(2 * below.size(), whole.size());
-  std::size_t k = 0;
-  for (const geom::SweepRef& m : below) {
-    ASSERT_LT(k, run.size());
-    ASSERT_TRUE(m.from.tip == run[k].from.tip);
-    for (; k < run.size() && !(run[k].to.tip == m.to.tip); ++k) {
-      const double reach = sampled_reach_below(c, run[k].to, z_top);
-      EXPECT_LE(geom::pose_deviation_mm(m.from, m.to, run[k].to, reach), 0.5 * kTol) << "pose " << k;
+  EXPECT_LT(below.size(), whole.size());
+  EXPECT_LE(4 * below.size(), run.size());
+  ASSERT_FALSE(below.empty());
+  EXPECT_TRUE(below.front().from.tip == run.front().from.tip);
+  EXPECT_TRUE(below.back().to.tip == run.back().to.tip);
+  std::size_t k = 0;  // the move that holds the merged sweep's start
+  std::size_t splits = 0;
+  for (std::size_t m = 0; m < below.size(); ++m) {
+    const geom::SweepRef& s = below[m];
+    if (m > 0) {
+      EXPECT_TRUE(s.from.tip == below[m - 1].to.tip && s.from.axis == below[m - 1].to.axis) << m;
     }
-    ++k;
+    // The poses inside: the ends of the moves from k on before the one that holds s's end.
+    while (k < run.size() && !(fraction_on(run[k], s.to) > 0.0)) {
+      const double reach = sampled_reach_below(c, run[k].to, z_top);
+      EXPECT_LE(geom::pose_deviation_mm(s.from, s.to, run[k].to, reach), 0.5 * kTol) << "pose " << k;
+      ++k;
+    }
+    ASSERT_LT(k, run.size()) << "merged sweep " << m << " ends on no move";
+    const double f = fraction_on(run[k], s.to);
+    if (f < 1.0 - 1e-12) ++splits;  // ends inside move k, which the next sweep goes on with
+    else ++k;
   }
   EXPECT_EQ(k, run.size());
+  EXPECT_GT(splits, 0u);
 }
 
 TEST(BatchPlan, MergedTiltedRunRemovesWhatItsMovesRemove) {

@@ -375,8 +375,9 @@ TEST(Sweep, TiltedPiecesWithNeighbourCoversKeepTheUnionWithFewerVertices) {
     geom::Paths covered, full;
     for (std::size_t i = 0; i < pieces.size(); ++i) {
       const auto& sw = sweeps[pieces[i].sweep];
-      sw.build_piece(pieces[i], i > 0 ? &pieces[i - 1] : nullptr, i + 1 < pieces.size() ? &pieces[i + 1] : nullptr, covered, sc);
-      sw.build_piece(pieces[i], nullptr, nullptr, full, sc);
+      sw.build_piece(pieces[i], {i > 0 ? &pieces[i - 1] : nullptr, i + 1 < pieces.size() ? &pieces[i + 1] : nullptr},
+                     covered, sc);
+      sw.build_piece(pieces[i], {}, full, sc);
     }
     ASSERT_EQ(full.size(), pieces.size());
     // The engine's way since: the previous piece's refined polygon covers too
@@ -384,9 +385,10 @@ TEST(Sweep, TiltedPiecesWithNeighbourCoversKeepTheUnionWithFewerVertices) {
     geom::ConvexCover cover[2];
     geom::Paths after_last;
     for (std::size_t i = 0; i < pieces.size(); ++i)
-      sweeps[pieces[i].sweep].build_piece(pieces[i], i > 0 ? &pieces[i - 1] : nullptr,
-                                          i + 1 < pieces.size() ? &pieces[i + 1] : nullptr, after_last, sc,
-                                          i > 0 ? &cover[(i - 1) % 2] : nullptr, &cover[i % 2]);
+      sweeps[pieces[i].sweep].build_piece(pieces[i],
+                                          {i > 0 ? &pieces[i - 1] : nullptr, i + 1 < pieces.size() ? &pieces[i + 1] : nullptr,
+                                           i > 0 ? &cover[(i - 1) % 2] : nullptr, &cover[i % 2]},
+                                          after_last, sc);
     std::size_t vc = 0, vf = 0, vl = 0;
     for (const auto& p : covered) vc += p.size();
     for (const auto& p : full) vf += p.size();
@@ -400,7 +402,7 @@ TEST(Sweep, TiltedPiecesWithNeighbourCoversKeepTheUnionWithFewerVertices) {
     EXPECT_NEAR(al, af, 40.0 * tol) << "z " << z;
     // The same with one piece's neighbours missing: its own arcs are then refined in full.
     geom::Paths alone;
-    sweeps[pieces[5].sweep].build_piece(pieces[5], nullptr, nullptr, alone, sc);
+    sweeps[pieces[5].sweep].build_piece(pieces[5], {}, alone, sc);
     EXPECT_NEAR(union_area(alone), union_area(geom::Paths{full[5]}), 1e-9);
   }
 }
@@ -514,8 +516,8 @@ TEST(Sweep, TiltedRasterNeedsFewSupportQueriesPerPoint) {
   geom::SectionScratch sc;
   geom::Paths out;
   for (std::size_t i = 0; i < pieces.size(); ++i)
-    sweeps[pieces[i].sweep].build_piece(pieces[i], i > 0 ? &pieces[i - 1] : nullptr,
-                                        i + 1 < pieces.size() ? &pieces[i + 1] : nullptr, out, sc);
+    sweeps[pieces[i].sweep].build_piece(pieces[i], {i > 0 ? &pieces[i - 1] : nullptr, i + 1 < pieces.size() ? &pieces[i + 1] : nullptr},
+                                        out, sc);
   std::size_t vertices = 0;
   for (const auto& p : out) vertices += p.size();
   const double per_coarse = static_cast<double>(coarse) / static_cast<double>(geom::TiltedPiece::kDirs * pieces.size());

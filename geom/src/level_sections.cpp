@@ -216,7 +216,7 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
   // Tilted sweeps' pieces (sub-steps) wait in ws.pieces until the run's next vertical sweep
   // or its end (build_tilted()).
   ws.pieces.clear();
-  auto flush_tilted = [&] { build_tilted(sh, ws, ls, stats); };
+  auto flush_tilted = [&] { build_tilted(sh, material, ws, ls, stats); };
   std::uint32_t si = run.first;
   while (si < run.second) {
     const Sweep& sw = sh.sweeps[si];
@@ -296,7 +296,7 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
 // tilted sweeps on this level), each refined only where neither neighbour's coarse polygon
 // covers its arcs (Sweep::build_piece(): all of them go into this level's one difference),
 // then joined in groups (join_tilted()).
-void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls,
+void SubtractEngine::build_tilted(const SubtractShared& sh, const PlaneMaterial& material, SubtractWorkspace& ws, LevelSections& ls,
                                   SubtractStats& stats) const {
   const std::size_t n = ws.pieces.size();
   if (n == 0) return;
@@ -311,9 +311,10 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, SubtractWorkspace& w
       continue;
     }
     const std::size_t before = ls.paths.size();
-    sh.sweeps[p.sweep].build_piece(p, i > 0 ? &ws.pieces[i - 1] : prior, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
-                                   ls.paths, ws.scratch, i > 0 ? &ws.piece_cover[(i - 1) % 2] : nullptr,
-                                   i + 1 < n ? &ws.piece_cover[i % 2] : nullptr);
+    const Sweep::PieceCovers covers{i > 0 ? &ws.pieces[i - 1] : prior, i + 1 < n ? &ws.pieces[i + 1] : nullptr,
+                                    i > 0 ? &ws.piece_cover[(i - 1) % 2] : nullptr,
+                                    i + 1 < n ? &ws.piece_cover[i % 2] : nullptr, &material};
+    sh.sweeps[p.sweep].build_piece(p, covers, ls.paths, ws.scratch);
     if (ls.paths.size() > before) id = std::max(id, sh.sweep_id[p.sweep]);
     if (ls.paths.size() - ls.box.size() >= kTiltedGroup) {
       join_tilted(ls.box.size(), id, ws, ls, stats);

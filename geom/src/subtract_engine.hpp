@@ -56,7 +56,8 @@ class SubtractEngine {
                    SubtractStats& stats) const;
   void build_run_sections(double zc, std::pair<std::uint32_t, std::uint32_t> run, const PlaneMaterial& material,
                           const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
-  void build_tilted(const SubtractShared& sh, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats) const;
+  void build_tilted(const SubtractShared& sh, const PlaneMaterial& material, SubtractWorkspace& ws, LevelSections& ls,
+                    SubtractStats& stats) const;
   // The solid's last tilted piece per level (the solid's own workspace's level_last):
   // sized and reset on the preparing thread (reset_level_last(), from prepare()), then read
   // and written per level by the one thread that builds that level.

@@ -1084,8 +1084,17 @@ const std::array<SectionScratch::P2, TiltedPiece::kDirs>& coarse_directions() no
 // split as well. So does a triangle (support lines moved out by the point accuracy) that
 // lies inside a cover's coarse polygon: what the chord leaves out there is removed by the
 // cover's own polygon.
-void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const TiltedPiece* cover0,
-                    const TiltedPiece* cover1, const ConvexCover* last, SectionScratch& sc) {
+struct RefineCovers {
+  const TiltedPiece* cover0;
+  const TiltedPiece* cover1;
+  const ConvexCover* last;
+  const PlaneMaterial* material;
+};
+
+void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const RefineCovers& rc, SectionScratch& sc) {
+  const TiltedPiece* cover0 = rc.cover0;
+  const TiltedPiece* cover1 = rc.cover1;
+  const ConvexCover* last = rc.last;
   constexpr int kStart = TiltedPiece::kDirs;
   constexpr int kMaxPoints = 8192;
   constexpr int kWarmSteps = 1;  // a middle direction starts from its neighbours' brackets
@@ -1131,6 +1140,24 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
     return ((both & 1) != 0 && cover0->covers(apex, margin)) || ((both & 2) != 0 && cover1->covers(apex, margin)) ||
            ((both & 4) != 0 && last->contains(apex));
   };
+  // The cap beyond chord ab (the section there) lies in the triangle that the chord's line
+  // cuts from the support lines at the proven bounds ha, hb (a and b lie in the section, so
+  // on their inner sides): when the plane's material meets none of it, the chord leaves out
+  // nothing that the difference would remove. Tested on the coarse intervals only: on
+  // finish5x, testing their halves and quarters too cost 9.68 G instructions against 9.18 G.
+  auto in_air = [&](const Iv& iv, double ha, double hb) {
+    if (rc.material == nullptr || !(ha < INFINITY && hb < INFINITY)) return false;
+    const double ex = iv.b.x - iv.a.x, ey = iv.b.y - iv.a.y;
+    const double da = iv.ua.x * ex + iv.ua.y * ey, db = iv.ub.x * ex + iv.ub.y * ey;
+    const double det = iv.ua.x * iv.ub.y - iv.ua.y * iv.ub.x;
+    if (!(da < 0.0 && db > 0.0 && det > 1e-12)) return false;
+    const double sa = (ha - (iv.ua.x * iv.a.x + iv.ua.y * iv.a.y)) / da;  // <= 0: before a
+    const double sb = (hb - (iv.ub.x * iv.a.x + iv.ub.y * iv.a.y)) / db;  // >= 1: after b
+    const P2 apex{(ha * iv.ub.y - hb * iv.ua.y) / det, (iv.ua.x * hb - iv.ub.x * ha) / det};
+    if (!(ey * (apex.x - iv.a.x) - ex * (apex.y - iv.a.y) >= 0.0)) return false;  // apex beyond the chord
+    const P2 tri[3] = {{iv.a.x + sb * ex, iv.a.y + sb * ey}, {iv.a.x + sa * ex, iv.a.y + sa * ey}, apex};
+    return !rc.material->may_meet(std::span<const P2>(tri, 3));
+  };
   int coarse_mask[kStart];
   std::fill(std::begin(coarse_mask), std::end(coarse_mask), -1);
   sc.pts.clear();
@@ -1147,7 +1174,7 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const T
       const double bound = 0.5 * tan_half[static_cast<std::size_t>(std::min(iv.depth, kDepths - 1))];  // |ab|/2 · tan(Δφ/2) / |ab|
       const bool fine = iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
                         bound * bound * (dx * dx + dy * dy) <= max_gap2;
-      const bool done = fine || covered(iv);
+      const bool done = fine || covered(iv) || (iv.depth == 0 && in_air(iv, di.h, dj.h));
       if (iv.depth == 0) {  // the coarse ends' covers, for the intervals beside
         coarse_mask[i] = iv.ma;
         coarse_mask[j] = iv.mb;
@@ -1485,19 +1512,18 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
   return added;
 }
 
-std::size_t Sweep::build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
-                               SectionScratch& sc, const ConvexCover* last, ConvexCover* keep) const {
+std::size_t Sweep::build_piece(const TiltedPiece& p, const PieceCovers& covers, Paths& out, SectionScratch& sc) const {
   const Hull3 hull(shape_, p.a, p.b, top_);
   const double tol = shape_->chord_tol_mm;
   const bool bisected = !(shape_->capsule_radius_mm > 0.0 && shape_->core_radius_mm == 0.0);
-  if (!bisected || (last != nullptr && last->empty())) last = nullptr;
-  refine_section(hull, p, tol, last != nullptr ? nullptr : cover0, cover1, last, sc);
+  const ConvexCover* last = bisected && covers.last != nullptr && !covers.last->empty() ? covers.last : nullptr;
+  refine_section(hull, p, tol, {last != nullptr ? nullptr : covers.before, covers.after, last, covers.material}, sc);
   sc.support_queries += hull.queries;
   convex_hull(sc.pts, sc.hull);
   const std::size_t emitted = emit(sc.hull, out, sc.spare);
-  if (keep != nullptr) {
-    if (bisected && emitted > 0) keep->build(sc.hull, cover_margin(tol));
-    else keep->clear();
+  if (covers.keep != nullptr) {
+    if (bisected && emitted > 0) covers.keep->build(sc.hull, cover_margin(tol));
+    else covers.keep->clear();
   }
   return emitted;
 }
@@ -1508,7 +1534,7 @@ std::size_t Sweep::section_general(double zc, Paths& out, SectionScratch& sc, co
   tilted_pieces(zc, sc.pieces, material);
   std::size_t emitted = 0;
   for (const TiltedPiece& p : sc.pieces)
-    if (!p.in_air) emitted += build_piece(p, nullptr, nullptr, out, sc);
+    if (!p.in_air) emitted += build_piece(p, {}, out, sc);
   return emitted;
 }
 

@@ -260,22 +260,31 @@ class Sweep {
   // box already clears has only those coarse points. Real-time safe once `out` has grown
   // and when `material` is (or is null).
   std::size_t tilted_pieces(double z_mm, std::vector<TiltedPiece>& out, const PlaneMaterial* material = nullptr) const;
+  // What a piece's refinement may leave out (build_piece()); every member may be null.
+  struct PieceCovers {
+    const TiltedPiece* before = nullptr;  // the piece before on the same plane
+    const TiltedPiece* after = nullptr;   // the piece after
+    const ConvexCover* last = nullptr;    // the polygon that `before` built
+    ConvexCover* keep = nullptr;          // takes this piece's polygon
+    const PlaneMaterial* material = nullptr;  // the plane's material before the difference
+  };
   // The section of piece `p` as one convex polygon appended to `out` (counter-clockwise,
   // kernel units); returns 1, or 0 when it has no area. Its boundary is refined to the chord
   // tolerance except on arcs whose refinement triangle (docs/lbr-conventions.md, "Sweeps and
-  // sections") lies inside the coarse polygon of `cover0` or `cover1` (pieces of the same
-  // plane, or null): there the polygon keeps only the coarse points, and is exact only
-  // together with those pieces' own polygons, which contain their coarse polygons. So the
-  // polygons of a sequence of pieces, each built with its neighbours as covers, have the
-  // union of their sections within the chord tolerance when removed in one difference.
-  // `last`, when given, is the polygon that cover0's piece built (kept by its call in `keep`;
-  // removed in the same difference: the caller's promise). It covers refined as it was, so
-  // it stands in for cover0's coarse polygon, which it contains. `keep`, when given, takes
-  // this piece's polygon for the next piece (emptied when there is none). Models whose
-  // boundary points are closed forms (the capsule) ignore both: a test costs as much as the
-  // point.
-  std::size_t build_piece(const TiltedPiece& p, const TiltedPiece* cover0, const TiltedPiece* cover1, Paths& out,
-                          SectionScratch& scratch, const ConvexCover* last = nullptr, ConvexCover* keep = nullptr) const;
+  // sections") lies inside the coarse polygon of `before` or `after` (pieces of the same
+  // plane): there the polygon keeps only the coarse points, and is exact only together with
+  // those pieces' own polygons, which contain their coarse polygons. So the polygons of a
+  // sequence of pieces, each built with its neighbours as covers, have the union of their
+  // sections within the chord tolerance when removed in one difference. `last` is the
+  // polygon that `before`'s piece built (kept by its call in `keep`; removed in the same
+  // difference: the caller's promise). It covers refined as it was, so it stands in for
+  // `before`'s coarse polygon, which it contains. `keep` takes this piece's polygon for the
+  // next piece (emptied when there is none). Models whose boundary points are closed forms
+  // (the capsule) ignore both: a test costs as much as the point. Nor is an arc refined
+  // whose cap (the section beyond its chord, inside the triangle of the chord and the two
+  // proven support lines) meets no `material`: what the chord leaves out there removes
+  // nothing.
+  std::size_t build_piece(const TiltedPiece& p, const PieceCovers& covers, Paths& out, SectionScratch& scratch) const;
 
   static constexpr int kMaxTiltSubsteps = 256;  // sub-steps of one sweep whose tool axis turns (kin::kMaxMoveSubsteps: pieces of a move)
 
