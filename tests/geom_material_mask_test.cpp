@@ -85,7 +85,8 @@ TEST(CellMask, ClearPixelsHoldNoMaterialAndPolygonsAwayFromItAreCleared) {
   std::vector<std::pair<int, double>> crossings;
   const auto xs = borders(s, true), ys = borders(s, false);
   const geom::detail::LevelMaterial m(s, level, xs, ys, masks, crossings);
-  const double pixel = 20.0 / geom::detail::CellMask::kSide;  // a region is 20 x 15 mm
+  // A region is 20 x 15 mm: 64 x 60 pixels (at most kMaxSide a row), 0.3125 x 0.25 mm.
+  const double pixel = 20.0 / geom::detail::CellMask::kMaxSide;
   std::mt19937 rng(7);
   int meeting = 0, cleared = 0, away = 0;
   for (int i = 0; i < 4000; ++i) {

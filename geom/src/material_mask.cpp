@@ -11,19 +11,6 @@ namespace lbr::geom::detail {
 
 namespace {
 
-constexpr int kLast = CellMask::kSide - 1;
-
-// Bits c0..c1 of a row (0 <= c0 <= c1 <= kLast).
-std::uint64_t span_bits(int c0, int c1) noexcept {
-  const std::uint64_t upto = c1 >= kLast ? ~std::uint64_t{0} : (std::uint64_t{1} << (c1 + 1)) - 1;
-  return upto & ~((std::uint64_t{1} << c0) - 1);
-}
-
-int clamp_pixel(double v) noexcept {
-  if (!(v >= 0.0)) return 0;  // NaN too
-  return v >= kLast ? kLast : static_cast<int>(v);
-}
-
 // The x-range of segment a-b within the band y in [lo, hi] (false when it misses the band).
 bool band_range(double ax, double ay, double bx, double by, double lo, double hi, double& xmin, double& xmax) noexcept {
   if ((ay < lo && by < lo) || (ay > hi && by > hi)) return false;
@@ -46,14 +33,31 @@ bool band_range(double ax, double ay, double bx, double by, double lo, double hi
 
 double CellMask::px(double x_mm) const noexcept { return (x_mm * kUnitsPerMm - x0_) * sx_; }
 double CellMask::py(double y_mm) const noexcept { return (y_mm * kUnitsPerMm - y0_) * sy_; }
+double CellMask::pixel_x_mm() const noexcept { return 1.0 / (sx_ * kUnitsPerMm); }
+double CellMask::pixel_y_mm() const noexcept { return 1.0 / (sy_ * kUnitsPerMm); }
+
+int CellMask::column(double v) const noexcept {
+  if (!(v >= 0.0)) return 0;  // NaN too
+  return v >= nx_ - 1 ? nx_ - 1 : static_cast<int>(v);
+}
+
+int CellMask::row(double v) const noexcept {
+  if (!(v >= 0.0)) return 0;
+  return v >= ny_ - 1 ? ny_ - 1 : static_cast<int>(v);
+}
+
+std::uint64_t CellMask::span(int c0, int c1) const noexcept {
+  const std::uint64_t upto = c1 >= 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (c1 + 1)) - 1;
+  return upto & ~((std::uint64_t{1} << c0) - 1);
+}
 
 // The pixels the edge passes through, row by row (pixel coordinates), widened by kEdgePad.
 void CellMask::mark_edge(double ax, double ay, double bx, double by) noexcept {
-  const int r0 = clamp_pixel(std::min(ay, by) - kEdgePad), r1 = clamp_pixel(std::max(ay, by) + kEdgePad);
+  const int r0 = row(std::min(ay, by) - kEdgePad), r1 = row(std::max(ay, by) + kEdgePad);
   for (int r = r0; r <= r1; ++r) {
     double xmin = 0.0, xmax = 0.0;
     if (!band_range(ax, ay, bx, by, r - kEdgePad, r + 1 + kEdgePad, xmin, xmax)) continue;
-    rows_[r] |= span_bits(clamp_pixel(xmin - kEdgePad), clamp_pixel(xmax + kEdgePad));
+    rows_[static_cast<std::size_t>(r)] |= span(column(xmin - kEdgePad), column(xmax + kEdgePad));
   }
 }
 
@@ -67,25 +71,32 @@ void CellMask::fill_rows(std::vector<std::pair<int, double>>& crossings) noexcep
     const int r = crossings[i].first;
     std::size_t j = i;
     while (j < crossings.size() && crossings[j].first == r) ++j;
-    if ((j - i) % 2 != 0) rows_[r] = ~std::uint64_t{0};
+    if ((j - i) % 2 != 0) rows_[static_cast<std::size_t>(r)] = span(0, nx_ - 1);
     for (std::size_t k = i; k + 1 < j && (j - i) % 2 == 0; k += 2) {
       // Centres c + 0.5 in [x_k, x_k+1].
       const double c0 = std::ceil(crossings[k].second - 0.5), c1 = std::floor(crossings[k + 1].second - 0.5);
-      if (c1 < 0.0 || c0 > kLast || c0 > c1) continue;
-      rows_[r] |= span_bits(clamp_pixel(c0), clamp_pixel(c1));
+      if (c1 < 0.0 || c0 > nx_ - 1 || c0 > c1) continue;
+      rows_[static_cast<std::size_t>(r)] |= span(column(c0), column(c1));
     }
     i = j;
   }
 }
 
 void CellMask::build(const Cell& cell, const Rect& region, std::vector<std::pair<int, double>>& crossings) {
-  std::fill(std::begin(rows_), std::end(rows_), std::uint64_t{0});
   version = cell.version;
   built = true;
   x0_ = static_cast<double>(region.x0);
   y0_ = static_cast<double>(region.y0);
-  sx_ = kSide / std::max(1.0, static_cast<double>(region.x1 - region.x0));
-  sy_ = kSide / std::max(1.0, static_cast<double>(region.y1 - region.y0));
+  const double wu = std::max(1.0, static_cast<double>(region.x1 - region.x0));
+  const double hu = std::max(1.0, static_cast<double>(region.y1 - region.y0));
+  auto side = [](double extent) {
+    return static_cast<int>(std::clamp(std::ceil(extent / (kPixelMm * kUnitsPerMm)), 1.0, static_cast<double>(kMaxSide)));
+  };
+  nx_ = side(wu);
+  ny_ = side(hu);
+  sx_ = nx_ / wu;
+  sy_ = ny_ / hu;
+  rows_.assign(static_cast<std::size_t>(ny_), std::uint64_t{0});
   crossings.clear();
   auto contour = [&](const Path& pts) {
     const std::size_t n = pts.size();
@@ -97,7 +108,8 @@ void CellMask::build(const Cell& cell, const Rect& region, std::vector<std::pair
       mark_edge(ax, ay, bx, by);
       // Crossings of the row centres y = r + 0.5 with ay <= y < by (or by <= y < ay).
       const double lo = std::min(ay, by), hi = std::max(ay, by);
-      const int r0 = std::max(0, static_cast<int>(std::ceil(lo - 0.5))), r1 = std::min(kLast, static_cast<int>(std::ceil(hi - 0.5)) - 1);
+      const int r0 = std::max(0, static_cast<int>(std::ceil(lo - 0.5)));
+      const int r1 = std::min(ny_ - 1, static_cast<int>(std::ceil(hi - 0.5)) - 1);
       for (int r = r0; r <= r1; ++r) {
         const double yc = r + 0.5;
         crossings.emplace_back(r, ax + (yc - ay) * (bx - ax) / (by - ay));
@@ -120,11 +132,12 @@ bool CellMask::may_meet(std::span<const SectionPoint> poly) const noexcept {
     ylo = std::min(ylo, py(q.y));
     yhi = std::max(yhi, py(q.y));
   }
-  if (xhi < 0.0 || yhi < 0.0 || xlo > kSide || ylo > kSide) return false;
-  const std::uint64_t box = span_bits(clamp_pixel(xlo), clamp_pixel(xhi));
-  const int r0 = clamp_pixel(ylo), r1 = clamp_pixel(yhi);
+  if (xhi < 0.0 || yhi < 0.0 || xlo > nx_ || ylo > ny_) return false;
+  const std::uint64_t box = span(column(xlo), column(xhi));
+  const int r0 = row(ylo), r1 = row(yhi);
   for (int r = r0; r <= r1; ++r) {
-    if ((rows_[r] & box) == 0) continue;
+    const std::uint64_t bits = rows_[static_cast<std::size_t>(r)];
+    if ((bits & box) == 0) continue;
     // The polygon's own x-range in this row (convex: its clipped edges' ends).
     double xmin = INFINITY, xmax = -INFINITY;
     for (std::size_t i = 0; i < poly.size(); ++i) {
@@ -135,8 +148,8 @@ bool CellMask::may_meet(std::span<const SectionPoint> poly) const noexcept {
       xmin = std::min(xmin, e0);
       xmax = std::max(xmax, e1);
     }
-    if (xmin > xmax || xmax < 0.0 || xmin > kSide) continue;
-    if ((rows_[r] & span_bits(clamp_pixel(xmin), clamp_pixel(xmax))) != 0) return true;
+    if (xmin > xmax || xmax < 0.0 || xmin > nx_) continue;
+    if ((bits & span(column(xmin), column(xmax))) != 0) return true;
   }
   return false;
 }
