@@ -1084,6 +1084,26 @@ const std::array<SectionScratch::P2, TiltedPiece::kDirs>& coarse_directions() no
 // split as well. So does a triangle (support lines moved out by the point accuracy) that
 // lies inside a cover's coarse polygon: what the chord leaves out there is removed by the
 // cover's own polygon.
+// The cap of the section beyond chord ab of coarse directions a and b (the section there)
+// lies in the triangle that the chord's line cuts from their support lines at the proven
+// bounds (a and b lie in the section, so on their inner sides): true when the plane's
+// material meets none of it, so that the chord leaves out nothing the difference would
+// remove. Tested on the coarse intervals only: on finish5x, testing their halves and
+// quarters too cost 9.68 G instructions against 9.18 G.
+bool cap_in_air(const PlaneMaterial& material, const SectionScratch::Dir& a, const SectionScratch::Dir& b) {
+  if (!(a.h < INFINITY && b.h < INFINITY)) return false;
+  const double ex = b.p.x - a.p.x, ey = b.p.y - a.p.y;
+  const double da = a.u.x * ex + a.u.y * ey, db = b.u.x * ex + b.u.y * ey;
+  const double det = a.u.x * b.u.y - a.u.y * b.u.x;
+  if (!(da < 0.0 && db > 0.0 && det > 1e-12)) return false;
+  const double sa = (a.h - (a.u.x * a.p.x + a.u.y * a.p.y)) / da;  // <= 0: before a
+  const double sb = (b.h - (b.u.x * a.p.x + b.u.y * a.p.y)) / db;  // >= 1: after b
+  const P2 apex{(a.h * b.u.y - b.h * a.u.y) / det, (a.u.x * b.h - b.u.x * a.h) / det};
+  if (!(ey * (apex.x - a.p.x) - ex * (apex.y - a.p.y) >= 0.0)) return false;  // apex beyond the chord
+  const P2 tri[3] = {{a.p.x + sb * ex, a.p.y + sb * ey}, {a.p.x + sa * ex, a.p.y + sa * ey}, apex};
+  return !material.may_meet(std::span<const P2>(tri, 3));
+}
+
 struct RefineCovers {
   const TiltedPiece* cover0;
   const TiltedPiece* cover1;
@@ -1140,24 +1160,6 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const R
     return ((both & 1) != 0 && cover0->covers(apex, margin)) || ((both & 2) != 0 && cover1->covers(apex, margin)) ||
            ((both & 4) != 0 && last->contains(apex));
   };
-  // The cap beyond chord ab (the section there) lies in the triangle that the chord's line
-  // cuts from the support lines at the proven bounds ha, hb (a and b lie in the section, so
-  // on their inner sides): when the plane's material meets none of it, the chord leaves out
-  // nothing that the difference would remove. Tested on the coarse intervals only: on
-  // finish5x, testing their halves and quarters too cost 9.68 G instructions against 9.18 G.
-  auto in_air = [&](const Iv& iv, double ha, double hb) {
-    if (rc.material == nullptr || !(ha < INFINITY && hb < INFINITY)) return false;
-    const double ex = iv.b.x - iv.a.x, ey = iv.b.y - iv.a.y;
-    const double da = iv.ua.x * ex + iv.ua.y * ey, db = iv.ub.x * ex + iv.ub.y * ey;
-    const double det = iv.ua.x * iv.ub.y - iv.ua.y * iv.ub.x;
-    if (!(da < 0.0 && db > 0.0 && det > 1e-12)) return false;
-    const double sa = (ha - (iv.ua.x * iv.a.x + iv.ua.y * iv.a.y)) / da;  // <= 0: before a
-    const double sb = (hb - (iv.ub.x * iv.a.x + iv.ub.y * iv.a.y)) / db;  // >= 1: after b
-    const P2 apex{(ha * iv.ub.y - hb * iv.ua.y) / det, (iv.ua.x * hb - iv.ub.x * ha) / det};
-    if (!(ey * (apex.x - iv.a.x) - ex * (apex.y - iv.a.y) >= 0.0)) return false;  // apex beyond the chord
-    const P2 tri[3] = {{iv.a.x + sb * ex, iv.a.y + sb * ey}, {iv.a.x + sa * ex, iv.a.y + sa * ey}, apex};
-    return !rc.material->may_meet(std::span<const P2>(tri, 3));
-  };
   int coarse_mask[kStart];
   std::fill(std::begin(coarse_mask), std::end(coarse_mask), -1);
   sc.pts.clear();
@@ -1174,7 +1176,8 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const R
       const double bound = 0.5 * tan_half[static_cast<std::size_t>(std::min(iv.depth, kDepths - 1))];  // |ab|/2 · tan(Δφ/2) / |ab|
       const bool fine = iv.depth >= 40 || static_cast<int>(sc.pts.size()) >= kMaxPoints || sp + 2 > 64 ||
                         bound * bound * (dx * dx + dy * dy) <= max_gap2;
-      const bool done = fine || covered(iv) || (iv.depth == 0 && in_air(iv, di.h, dj.h));
+      const bool done = fine || covered(iv) ||
+                        (iv.depth == 0 && rc.material != nullptr && cap_in_air(*rc.material, di, dj));
       if (iv.depth == 0) {  // the coarse ends' covers, for the intervals beside
         coarse_mask[i] = iv.ma;
         coarse_mask[j] = iv.mb;
