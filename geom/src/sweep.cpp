@@ -360,6 +360,24 @@ struct Hull3 {
     lo = std::max(lo, zl - cap_r);
     hi = std::min(hi, zh + cap_r);
   }
+  // The capsule's or rounded core's hull's box in XY [mm] (exact for its disks and balls)
+  // and the mean of its segment ends.
+  void xy_extent(double& x0, double& y0, double& x1, double& y1, double& cx, double& cy) const noexcept {
+    x0 = y0 = INFINITY;
+    x1 = y1 = -INFINITY;
+    cx = cy = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      const Vec3& a = pose[i / 2].axis;
+      const double ex = core * std::sqrt(std::max(0.0, 1.0 - a.x * a.x)) + cap_r;
+      const double ey = core * std::sqrt(std::max(0.0, 1.0 - a.y * a.y)) + cap_r;
+      x0 = std::min(x0, q[i].x - ex);
+      x1 = std::max(x1, q[i].x + ex);
+      y0 = std::min(y0, q[i].y - ey);
+      y1 = std::max(y1, q[i].y + ey);
+      cx += 0.25 * q[i].x;
+      cy += 0.25 * q[i].y;
+    }
+  }
   // The rounded core model's support point in direction d: the best of the four core disks'
   // (a disk of radius ρ about c normal to a: c + ρ·d⊥/|d⊥|), moved out by cap_r along d.
   Vec3 core_support(const Vec3& d) const noexcept {
@@ -1205,27 +1223,36 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const R
   }
 }
 
-// True when the sub-step's hull (circles c[0..n)) certainly misses the material box `m`
-// [units] in XY: their boxes are apart, or the horizontal direction u from the box's
-// centre to the circles' centroid separates them (the hull's least u·p, one support query,
-// beyond the box's greatest). The section on any plane lies in the hull, so it would
-// remove nothing.
-bool beside_material(const Hull3& hull, const Circle* c, int n, const Rect& m) noexcept {
-  if (m.empty()) return true;
+// A sub-step hull's box in XY and a point inside it [mm].
+struct HullBox {
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY, cx = 0.0, cy = 0.0;
+};
+
+// The box of station circles c[0..n) and their centres' mean.
+HullBox circles_box(const Circle* c, int n) noexcept {
+  HullBox b;
   for (int i = 0; i < n; ++i) {
     const double ex = c[i].r * std::sqrt(std::max(0.0, 1.0 - c[i].n.x * c[i].n.x));
     const double ey = c[i].r * std::sqrt(std::max(0.0, 1.0 - c[i].n.y * c[i].n.y));
-    x0 = std::min(x0, c[i].c.x - ex);
-    x1 = std::max(x1, c[i].c.x + ex);
-    y0 = std::min(y0, c[i].c.y - ey);
-    y1 = std::max(y1, c[i].c.y + ey);
-    cx += c[i].c.x / n;
-    cy += c[i].c.y / n;
+    b.x0 = std::min(b.x0, c[i].c.x - ex);
+    b.x1 = std::max(b.x1, c[i].c.x + ex);
+    b.y0 = std::min(b.y0, c[i].c.y - ey);
+    b.y1 = std::max(b.y1, c[i].c.y + ey);
+    b.cx += c[i].c.x / n;
+    b.cy += c[i].c.y / n;
   }
+  return b;
+}
+
+// True when the sub-step's hull (box b) certainly misses the material box `m` [units] in
+// XY: the boxes are apart, or the horizontal direction u from the box's centre to b's
+// centre point separates them (the hull's least u·p, one support query, beyond the box's
+// greatest). The section on any plane lies in the hull, so it would remove nothing.
+bool beside_material(const Hull3& hull, const HullBox& b, const Rect& m) noexcept {
+  if (m.empty()) return true;
   const double mx0 = to_mm(m.x0), mx1 = to_mm(m.x1), my0 = to_mm(m.y0), my1 = to_mm(m.y1);
-  if (x1 < mx0 || x0 > mx1 || y1 < my0 || y0 > my1) return true;
-  const double ux = cx - 0.5 * (mx0 + mx1), uy = cy - 0.5 * (my0 + my1), ul = std::sqrt(ux * ux + uy * uy);
+  if (b.x1 < mx0 || b.x0 > mx1 || b.y1 < my0 || b.y0 > my1) return true;
+  const double ux = b.cx - 0.5 * (mx0 + mx1), uy = b.cy - 0.5 * (my0 + my1), ul = std::sqrt(ux * ux + uy * uy);
   if (!(ul > 0.0)) return false;
   const Vec3 u{ux / ul, uy / ul, 0.0};
   const double hull_min = dot(hull.support(Vec3{-u.x, -u.y, 0.0}), u);
@@ -1233,6 +1260,31 @@ bool beside_material(const Hull3& hull, const Circle* c, int n, const Rect& m) n
   return hull_min > box_max;
 }
 
+// The z-range of sub-step a→b's hull [mm] and, when `box`, its XY box: the capsule's and the
+// rounded core's from their exact hull (no station circles), the station model's from its
+// circles at both poses.
+void substep_extent(const CutterShape& s, const Hull3& hull, const Pose& a, const Pose& b, double top, double& zlo,
+                    double& zhi, HullBox* box) noexcept {
+  zlo = -INFINITY;
+  zhi = INFINITY;
+  if (s.capsule_radius_mm > 0.0) {
+    hull.clamp_z_extent(zlo, zhi);
+    if (box != nullptr) hull.xy_extent(box->x0, box->y0, box->x1, box->y1, box->cx, box->cy);
+    return;
+  }
+  constexpr int kMaxStations = 512;
+  Circle circles[2 * kMaxStations];
+  int nc = station_circles(s, a, top, circles);
+  nc += station_circles(s, b, top, circles + nc);
+  zlo = INFINITY;
+  zhi = -INFINITY;
+  for (int i = 0; i < nc; ++i) {
+    const double e = circles[i].r * std::sqrt(std::max(0.0, 1.0 - circles[i].n.z * circles[i].n.z));
+    zlo = std::min(zlo, circles[i].c.z - e);
+    zhi = std::max(zhi, circles[i].c.z + e);
+  }
+  if (box != nullptr) *box = circles_box(circles, nc);
+}
 
 // A pseudo-angle of (dx, dy) in [0, 4): increasing with the angle from +x counter-clockwise.
 double pseudo_angle(double dx, double dy) noexcept {
@@ -1475,31 +1527,22 @@ int TiltedPiece::outer_polygon(int step, SectionScratch::P2 (&out)[kMaxOuter]) c
 std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const PlaneMaterial* material) const {
   if (vertical_ || zc < box_.lo.z || zc > box_.hi.z) return 0;
   const CutterShape& s = *shape_;
-  const int ns = static_cast<int>(s.stations.size());
-  constexpr int kMaxStations = 512;
-  Circle circles[2 * kMaxStations];
-  if (ns > kMaxStations) return 0;
+  constexpr std::size_t kMaxStations = 512;  // substep_extent()'s circles
+  if (s.stations.size() > kMaxStations) return 0;
   std::size_t added = 0;
   Pose a{from_.tip, from_.axis};
   const int n = substeps_at(zc);
   for (int k = 1; k <= n; ++k) {
     const double t = static_cast<double>(k) / n;
     const Pose b{lerp(from_.tip, to_.tip, t), normalized(lerp(from_.axis, to_.axis, t))};
-    int nc = station_circles(s, a, top_, circles);
-    nc += station_circles(s, b, top_, circles + nc);
     const Pose pa = a;
     a = b;
-    // Quick z test for this sub-step.
-    double zlo = INFINITY, zhi = -INFINITY;
-    for (int i = 0; i < nc; ++i) {
-      const double e = circles[i].r * std::sqrt(std::max(0.0, 1.0 - circles[i].n.z * circles[i].n.z));
-      zlo = std::min(zlo, circles[i].c.z - e);
-      zhi = std::max(zhi, circles[i].c.z + e);
-    }
     const Hull3 hull(&s, pa, b, top_);
-    hull.clamp_z_extent(zlo, zhi);
+    double zlo = 0.0, zhi = 0.0;
+    HullBox hb;
+    substep_extent(s, hull, pa, b, top_, zlo, zhi, material != nullptr ? &hb : nullptr);
     if (zc < zlo || zc > zhi) continue;
-    if (material != nullptr && beside_material(hull, circles, nc, material->box)) continue;
+    if (material != nullptr && beside_material(hull, hb, material->box)) continue;
     const bool warm = !out.empty() && out.back().zc == zc;
     out.emplace_back();
     TiltedPiece& p = out.back();
