@@ -183,7 +183,10 @@ bool LevelMaterial::may_meet(std::span<const SectionPoint> poly) const {
       const Cell& c = s_.cell(region, level_);
       if (!c.bbox.intersects(pb)) continue;
       CellMask& m = masks_[static_cast<std::size_t>(region) * levels + static_cast<std::size_t>(level_)];
-      if (!m.built || m.version != c.version) m.build(c, s_.region_rect(region), crossings_);
+      if (!m.built) m.build(c, s_.region_rect(region), crossings_);
+      if (!m.may_meet(poly)) continue;  // a mask built before later cuts holds more material: still clear
+      if (m.version == c.version) return true;
+      m.build(c, s_.region_rect(region), crossings_);
       if (m.may_meet(poly)) return true;
     }
   return false;

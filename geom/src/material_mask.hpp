@@ -54,9 +54,12 @@ class CellMask {
 };
 
 // The material of one level before a batch, for Sweep::tilted_pieces(): the box of its
-// cells, and their masks (built when a polygon first reaches a cell that changed since its
-// mask was built). Region borders, cells and masks are the solid's; `crossings` is the
-// calling thread's buffer. Only the thread that builds the level may use it.
+// cells, and their masks. A subtraction only removes material, and the masks are forgotten
+// whenever the solid may have had material put back (its removal epoch), so a mask built
+// before the cell's last changes holds all of its material and more: a polygon it clears
+// is clear. It is rebuilt only when it does not clear one. Region borders, cells and masks
+// are the solid's; `crossings` is the calling thread's buffer. Only the thread that builds
+// the level may use it.
 class LevelMaterial final : public PlaneMaterial {
  public:
   LevelMaterial(const LbrSolid& solid, int level, std::span<const Coord> xs, std::span<const Coord> ys,
