@@ -43,7 +43,9 @@ double removed_mm3(const std::string& program, app::Interpreter interp) {
   const std::string path = ::testing::TempDir() + "g7x_" + t->name() + "_" + std::to_string(::getpid()) + ".ngc";
   std::ofstream(path) << program;
   const app::Profile profile = sharp_lathe();
-  return app::run_batch(profile, app::load_toolpath(path, profile, interp)).removed_volume_mm3;
+  const double removed = app::run_batch(profile, app::load_toolpath(path, profile, interp)).removed_volume_mm3;
+  std::remove(path.c_str());
+  return removed;
 }
 
 // Both interpreters (rs274 when installed) against the analytic volume.
@@ -117,6 +119,7 @@ void expect_path(const std::string& program, const std::vector<std::array<double
       ::testing::TempDir() + "g7x_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".ngc";
   std::ofstream(path) << program;
   const std::vector<std::array<double, 3>> theirs = path_of(nc::run_rs274(path, o));
+  std::remove(path.c_str());
   ASSERT_EQ(ours.size(), theirs.size());
   for (std::size_t i = 0; i < ours.size(); ++i)
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(ours[i][k], theirs[i][k], 1e-4) << i;
@@ -229,6 +232,7 @@ void expect_rapids_as_rs274(const std::string& program, double tol_mm = 2e-3) {
   const std::string path = ::testing::TempDir() + "g7x_rapids_" + std::to_string(::getpid()) + ".ngc";
   std::ofstream(path) << program;
   const auto ours = rapids(nc::interpret_gcode(program, "t.ngc", o)), theirs = rapids(nc::run_rs274(path, o));
+  std::remove(path.c_str());
   ASSERT_EQ(ours.size(), theirs.size());
   for (std::size_t i = 0; i < ours.size(); ++i)
     for (int k = 0; k < 2; ++k) EXPECT_NEAR(ours[i][k], theirs[i][k], tol_mm) << i;
