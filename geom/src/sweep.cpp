@@ -1489,7 +1489,6 @@ bool TiltedPiece::covers(const SectionScratch::P2& q, double margin_mm) const no
 }
 
 int TiltedPiece::outer_polygon(int step, SectionScratch::P2 (&out)[kMaxOuter]) const noexcept {
-  using P2 = SectionScratch::P2;
   constexpr int axis = kDirs / 4;
   constexpr double kOut = 1.0 / kUnitsPerMm;  // a kernel unit beyond each bound
   // The box of the axis directions' bounds (their unit vectors are the axes to 1e-16).
