@@ -1,4 +1,4 @@
-// A cell's material as a conservative raster, and a tilted piece's outer polygon
+// A cell's material as a conservative raster, and a level's material for the tilted pieces
 // (material_mask.hpp).
 #include "material_mask.hpp"
 
@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "geom/units.hpp"
+#include "subtract_engine.hpp"  // interval_of()
 
 namespace lbr::geom::detail {
 
@@ -33,8 +34,6 @@ bool band_range(double ax, double ay, double bx, double by, double lo, double hi
 
 double CellMask::px(double x_mm) const noexcept { return (x_mm * kUnitsPerMm - x0_) * sx_; }
 double CellMask::py(double y_mm) const noexcept { return (y_mm * kUnitsPerMm - y0_) * sy_; }
-double CellMask::pixel_x_mm() const noexcept { return 1.0 / (sx_ * kUnitsPerMm); }
-double CellMask::pixel_y_mm() const noexcept { return 1.0 / (sy_ * kUnitsPerMm); }
 
 int CellMask::column(double v) const noexcept {
   if (!(v >= 0.0)) return 0;  // NaN too
@@ -154,7 +153,7 @@ bool CellMask::may_meet(std::span<const SectionPoint> poly) const noexcept {
   return false;
 }
 
-LevelMaterial::LevelMaterial(const LbrSolid& solid, int level, std::span<const Coord> xs, std::span<const Coord> ys,
+LevelMaterial::LevelMaterial(const LbrSolid& solid, int level, const std::vector<Coord>& xs, const std::vector<Coord>& ys,
                              std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings) noexcept
     : s_(solid), level_(level), xs_(xs), ys_(ys), masks_(masks), crossings_(crossings) {
   for (int r = 0; r < solid.regions(); ++r) box.add(solid.cell(r, level).bbox);
@@ -168,14 +167,10 @@ bool LevelMaterial::may_meet(std::span<const SectionPoint> poly) const {
     pb.add(Point{static_cast<Coord>(std::ceil(q.x * kUnitsPerMm)), static_cast<Coord>(std::ceil(q.y * kUnitsPerMm))});
   }
   if (!pb.intersects(box)) return false;
-  // The regions whose rectangles the box reaches (borders ascending; a box that starts on a
-  // border reaches the region before it too).
-  auto first = [](std::span<const Coord> b, Coord v) {
-    const auto it = std::upper_bound(b.begin() + 1, b.end() - 1, v);
-    return static_cast<int>(it - b.begin()) - 1;
-  };
-  const int ix0 = first(xs_, pb.x0 - 1), ix1 = first(xs_, pb.x1);
-  const int iy0 = first(ys_, pb.y0 - 1), iy1 = first(ys_, pb.y1);
+  // The regions whose rectangles the box reaches (a box that starts on a border reaches the
+  // region before it too).
+  const int ix0 = interval_of(xs_, pb.x0 - 1), ix1 = interval_of(xs_, pb.x1);
+  const int iy0 = interval_of(ys_, pb.y0 - 1), iy1 = interval_of(ys_, pb.y1);
   const auto levels = static_cast<std::size_t>(s_.levels());
   for (int iy = iy0; iy <= iy1; ++iy)
     for (int ix = ix0; ix <= ix1; ++ix) {

@@ -18,8 +18,9 @@ namespace lbr::geom::detail {
 // every pixel whose centre lies inside the material (even-odd over the cell's contours,
 // which do not cross). A pixel that no edge touches lies wholly inside or wholly outside,
 // as its centre does, so a clear bit means no material anywhere in it. Built from a cell in
-// O(edges + crossings + rows); used as long as the cell's version is the one it was built
-// from. Holds one 64-bit word per row: a 15 mm cell 480 bytes, a 3.75 mm cell 120.
+// O(edges + crossings + rows); `version` is the cell's version it was built from
+// (LevelMaterial rebuilds it when that matters). Holds one 64-bit word per row: a 15 mm cell
+// 480 bytes, a 3.75 mm cell 120.
 class CellMask {
  public:
   static constexpr int kMaxSide = 64;       // pixels per row at most: one std::uint64_t
@@ -31,9 +32,6 @@ class CellMask {
   void build(const Cell& cell, const Rect& region, std::vector<std::pair<int, double>>& crossings);
   // True when some pixel that the convex polygon `poly` [mm] overlaps may hold material.
   [[nodiscard]] bool may_meet(std::span<const SectionPoint> poly) const noexcept;
-  // The pixel's size [mm] along x and y.
-  [[nodiscard]] double pixel_x_mm() const noexcept;
-  [[nodiscard]] double pixel_y_mm() const noexcept;
 
   std::uint32_t version = 0;  // the cell's version it was built from
   bool built = false;         // false: to be built before use
@@ -62,14 +60,15 @@ class CellMask {
 // the level may use it.
 class LevelMaterial final : public PlaneMaterial {
  public:
-  LevelMaterial(const LbrSolid& solid, int level, std::span<const Coord> xs, std::span<const Coord> ys,
+  LevelMaterial(const LbrSolid& solid, int level, const std::vector<Coord>& xs, const std::vector<Coord>& ys,
                 std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings) noexcept;
   [[nodiscard]] bool may_meet(std::span<const SectionPoint> poly) const override;
 
  private:
   const LbrSolid& s_;
   int level_;
-  std::span<const Coord> xs_, ys_;  // region borders [units], regions + 1 each
+  const std::vector<Coord>& xs_;  // region borders [units], regions + 1 each (interval_of())
+  const std::vector<Coord>& ys_;
   std::vector<CellMask>& masks_;    // per cell, or empty: every polygon may meet material
   std::vector<std::pair<int, double>>& crossings_;
 };

@@ -146,8 +146,8 @@ struct SubtractWorkspace {
   std::vector<std::uint8_t> level_last_set;
   std::uint64_t level_last_epoch = 0;
   // Per cell (region * levels + level), its material as a raster, built when a tilted piece
-  // first asks after the cell changed (LevelMaterial); sized on the first batch
-  // with a tilted sweep and reset with the removal epoch. Only the solid's own workspace
+  // first reaches the cell and rebuilt when it no longer clears one (LevelMaterial); sized on
+  // the first batch with a tilted sweep and forgotten with the removal epoch. Only the solid's own workspace
   // holds them; a cell is read and built by the one thread that builds its level.
   std::vector<CellMask> masks;
   std::uint64_t masks_epoch = 0;

@@ -119,6 +119,15 @@ struct P3 {
 };
 P3 p3(const Vec3& v) noexcept { return {v.x, v.y, v.z}; }
 
+// Station circles of one pose a tilted sub-step takes at most (a profile with more is not
+// sectioned: Sweep::tilted_pieces()).
+constexpr std::size_t kMaxStations = 512;
+
+// A sub-step hull's box in XY and a point inside it [mm].
+struct HullBox {
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY, cx = 0.0, cy = 0.0;
+};
+
 // A station circle of the tool at one pose.
 struct Circle {
   P3 c, n;
@@ -362,21 +371,20 @@ struct Hull3 {
   }
   // The capsule's or rounded core's hull's box in XY [mm] (exact for its disks and balls)
   // and the mean of its segment ends.
-  void xy_extent(double& x0, double& y0, double& x1, double& y1, double& cx, double& cy) const noexcept {
-    x0 = y0 = INFINITY;
-    x1 = y1 = -INFINITY;
-    cx = cy = 0.0;
+  HullBox xy_extent() const noexcept {
+    HullBox b;
     for (int i = 0; i < 4; ++i) {
       const Vec3& a = pose[i / 2].axis;
       const double ex = core * std::sqrt(std::max(0.0, 1.0 - a.x * a.x)) + cap_r;
       const double ey = core * std::sqrt(std::max(0.0, 1.0 - a.y * a.y)) + cap_r;
-      x0 = std::min(x0, q[i].x - ex);
-      x1 = std::max(x1, q[i].x + ex);
-      y0 = std::min(y0, q[i].y - ey);
-      y1 = std::max(y1, q[i].y + ey);
-      cx += 0.25 * q[i].x;
-      cy += 0.25 * q[i].y;
+      b.x0 = std::min(b.x0, q[i].x - ex);
+      b.x1 = std::max(b.x1, q[i].x + ex);
+      b.y0 = std::min(b.y0, q[i].y - ey);
+      b.y1 = std::max(b.y1, q[i].y + ey);
+      b.cx += 0.25 * q[i].x;
+      b.cy += 0.25 * q[i].y;
     }
+    return b;
   }
   // The rounded core model's support point in direction d: the best of the four core disks'
   // (a disk of radius ρ about c normal to a: c + ρ·d⊥/|d⊥|), moved out by cap_r along d.
@@ -1122,16 +1130,10 @@ bool cap_in_air(const PlaneMaterial& material, const SectionScratch::Dir& a, con
   return !material.may_meet(std::span<const P2>(tri, 3));
 }
 
-struct RefineCovers {
-  const TiltedPiece* cover0;
-  const TiltedPiece* cover1;
-  const ConvexCover* last;
-  const PlaneMaterial* material;
-};
-
-void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const RefineCovers& rc, SectionScratch& sc) {
-  const TiltedPiece* cover0 = rc.cover0;
-  const TiltedPiece* cover1 = rc.cover1;
+void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const Sweep::PieceCovers& rc,
+                    SectionScratch& sc) {
+  const TiltedPiece* cover0 = rc.before;
+  const TiltedPiece* cover1 = rc.after;
   const ConvexCover* last = rc.last;
   constexpr int kStart = TiltedPiece::kDirs;
   constexpr int kMaxPoints = 8192;
@@ -1223,11 +1225,6 @@ void refine_section(const Hull3& hull, const TiltedPiece& p, double tol, const R
   }
 }
 
-// A sub-step hull's box in XY and a point inside it [mm].
-struct HullBox {
-  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY, cx = 0.0, cy = 0.0;
-};
-
 // The box of station circles c[0..n) and their centres' mean.
 HullBox circles_box(const Circle* c, int n) noexcept {
   HullBox b;
@@ -1269,10 +1266,9 @@ void substep_extent(const CutterShape& s, const Hull3& hull, const Pose& a, cons
   zhi = INFINITY;
   if (s.capsule_radius_mm > 0.0) {
     hull.clamp_z_extent(zlo, zhi);
-    if (box != nullptr) hull.xy_extent(box->x0, box->y0, box->x1, box->y1, box->cx, box->cy);
+    if (box != nullptr) *box = hull.xy_extent();
     return;
   }
-  constexpr int kMaxStations = 512;
   Circle circles[2 * kMaxStations];
   int nc = station_circles(s, a, top, circles);
   nc += station_circles(s, b, top, circles + nc);
@@ -1381,14 +1377,13 @@ void coarse_section(const Hull3& hull, double tol, const TiltedPiece* prev, cons
   constexpr int n = TiltedPiece::kDirs, axis = n / 4;
   const double eps = kPointEps * tol;
   double tlo = -1.0, thi = 1.0;
-  P2 outer[TiltedPiece::kMaxOuter];
+  P2 box[4];
   p.in_air = false;
   if (material == nullptr) {
     for (int i = 0; i < n; ++i) coarse_direction(hull, eps, prev, prev2, i, tlo, thi, p);
   } else {
     for (int i = 0; i < n; i += axis) coarse_direction(hull, eps, prev, prev2, i, tlo, thi, p);
-    const int nb = p.outer_polygon(axis, outer);
-    if (nb > 0 && !material->may_meet(std::span<const P2>(outer, static_cast<std::size_t>(nb)))) {
+    if (p.axis_box(box) && !material->may_meet(std::span<const P2>(box, 4))) {
       mark_in_air(prev, p);
       return;
     }
@@ -1488,45 +1483,23 @@ bool TiltedPiece::covers(const SectionScratch::P2& q, double margin_mm) const no
   return true;
 }
 
-int TiltedPiece::outer_polygon(int step, SectionScratch::P2 (&out)[kMaxOuter]) const noexcept {
+bool TiltedPiece::axis_box(SectionScratch::P2 (&out)[4]) const noexcept {
   constexpr int axis = kDirs / 4;
   constexpr double kOut = 1.0 / kUnitsPerMm;  // a kernel unit beyond each bound
-  // The box of the axis directions' bounds (their unit vectors are the axes to 1e-16).
+  // The axis directions' unit vectors are the axes to 1e-16.
   const double bx1 = dirs[0].h + kOut, by1 = dirs[axis].h + kOut;
   const double bx0 = -dirs[2 * axis].h - kOut, by0 = -dirs[3 * axis].h - kOut;
-  if (!(bx0 < bx1 && by0 < by1) || !(bx1 - bx0 < INFINITY && by1 - by0 < INFINITY)) return 0;  // (NaN too)
+  if (!(bx0 < bx1 && by0 < by1) || !(bx1 - bx0 < INFINITY && by1 - by0 < INFINITY)) return false;  // (NaN too)
   out[0] = {bx0, by0};
   out[1] = {bx1, by0};
   out[2] = {bx1, by1};
   out[3] = {bx0, by1};
-  int n = 4;
-  P2 tmp[kMaxOuter];
-  for (int i = step; i < kDirs && n >= 3; i += step) {
-    if (i % axis == 0) continue;
-    const P2 u = dirs[i].u;
-    const double h = dirs[i].h + kOut;
-    if (!(std::abs(h) < INFINITY)) continue;  // no bound in this direction
-    int m = 0;
-    for (int k = 0; k < n && m + 2 <= kMaxOuter; ++k) {
-      const P2& e0 = out[k];
-      const P2& e1 = out[k + 1 == n ? 0 : k + 1];
-      const double d0 = u.x * e0.x + u.y * e0.y - h, d1 = u.x * e1.x + u.y * e1.y - h;
-      if (d0 <= 0.0) tmp[m++] = e0;
-      if ((d0 < 0.0 && d1 > 0.0) || (d0 > 0.0 && d1 < 0.0)) {
-        const double w = d0 / (d0 - d1);
-        tmp[m++] = {e0.x + w * (e1.x - e0.x), e0.y + w * (e1.y - e0.y)};
-      }
-    }
-    std::copy(tmp, tmp + m, out);
-    n = m;
-  }
-  return n >= 3 ? n : 0;
+  return true;
 }
 
 std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const PlaneMaterial* material) const {
   if (vertical_ || zc < box_.lo.z || zc > box_.hi.z) return 0;
   const CutterShape& s = *shape_;
-  constexpr std::size_t kMaxStations = 512;  // substep_extent()'s circles
   if (s.stations.size() > kMaxStations) return 0;
   std::size_t added = 0;
   Pose a{from_.tip, from_.axis};
@@ -1562,7 +1535,8 @@ std::size_t Sweep::build_piece(const TiltedPiece& p, const PieceCovers& covers, 
   const double tol = shape_->chord_tol_mm;
   const bool bisected = !(shape_->capsule_radius_mm > 0.0 && shape_->core_radius_mm == 0.0);
   const ConvexCover* last = bisected && covers.last != nullptr && !covers.last->empty() ? covers.last : nullptr;
-  refine_section(hull, p, tol, {last != nullptr ? nullptr : covers.before, covers.after, last, covers.material}, sc);
+  refine_section(hull, p, tol, {last != nullptr ? nullptr : covers.before, covers.after, last, nullptr, covers.material},
+                 sc);
   sc.support_queries += hull.queries;
   convex_hull(sc.pts, sc.hull);
   const std::size_t emitted = emit(sc.hull, out, sc.spare);

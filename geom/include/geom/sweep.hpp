@@ -175,12 +175,10 @@ struct TiltedPiece {
   // and its coarse points may be only those of the axis directions (then edge_count is 0).
   bool in_air = false;
   [[nodiscard]] bool covers(const SectionScratch::P2& p, double margin_mm) const noexcept;
-  // The polygon of its coarse directions' proven bounds (Dir::h), each moved out by a kernel
-  // unit, into `out` (counter-clockwise): the section lies inside it. Directions `step`
-  // apart only (1: all, kDirs / 4: the axes' box). Returns its vertex count, 0 when the
-  // bounds leave nothing.
-  static constexpr int kMaxOuter = 4 + kDirs;  // a box cut by kDirs half-planes
-  int outer_polygon(int step, SectionScratch::P2 (&out)[kMaxOuter]) const noexcept;
+  // The box of its axis directions' proven bounds (Dir::h), each moved out by a kernel
+  // unit, into `out` (counter-clockwise): the section lies inside it. False when the bounds
+  // leave no box (not finite, or crossed).
+  bool axis_box(SectionScratch::P2 (&out)[4]) const noexcept;
 };
 
 // Removes from convex polygon `b` (counter-clockwise, kernel units) the vertices that lie
@@ -225,8 +223,8 @@ class Sweep {
   // avoid allocation once it has grown. Real-time safe once the buffers have grown.
   // `material`, when given, is what the section may remove on this plane: a tilted sub-step
   // whose swept hull lies wholly beside its box (the boxes, or one horizontal direction that
-  // separates the two), or whose section's outer polygon it does not meet, is not built, as
-  // its section would remove nothing.
+  // separates the two), or whose section's axis box (TiltedPiece::axis_box()) it does not
+  // meet, is not built, as its section would remove nothing.
   std::size_t section(double z_mm, Paths& out, SectionScratch& scratch, const PlaneMaterial* material = nullptr) const;
 
   // Circles become regular n-gons that deviate from them on both sides, so that they carry no
@@ -255,10 +253,10 @@ class Sweep {
 
   // Tilted sweeps only: appends to `out` one TiltedPiece per sub-step whose hull meets plane
   // z = z_mm and, when `material` is given, does not lie beside its box (as section());
-  // returns how many. A piece whose section's outer polygon does not meet `material` is
-  // marked in_air; the box of its axis directions' bounds is tried first, and a piece that
-  // box already clears has only those coarse points. Real-time safe once `out` has grown
-  // and when `material` is (or is null).
+  // returns how many. With `material`, a piece's axis directions are searched first, and a
+  // piece whose axis box (TiltedPiece::axis_box()) does not meet `material` is marked in_air
+  // and has only those coarse points. Real-time safe once `out` has grown and when
+  // `material` is (or is null).
   std::size_t tilted_pieces(double z_mm, std::vector<TiltedPiece>& out, const PlaneMaterial* material = nullptr) const;
   // What a piece's refinement may leave out (build_piece()); every member may be null.
   struct PieceCovers {
