@@ -113,6 +113,25 @@ TEST(CellMask, ClearPixelsHoldNoMaterialAndPolygonsAwayFromItAreCleared) {
   for (int i = 0; i < 200; ++i) EXPECT_FALSE(after.may_meet(random_polygon(rng, -2.0, 42.0, -2.0, 32.0)));
 }
 
+TEST(CellMask, APolygonBeyondTheCoordinateRangeOrNotFiniteMayMeetMaterial) {
+  // A cap triangle of almost parallel support lines has its apex far away (1e15 mm is past
+  // the kernel's 64-bit units); a degenerate one may hold a NaN. Neither is cleared, and
+  // neither overflows the conversion to units (the sanitizer build checks that).
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {40, 30, 0}, 0.5, 2, 2));
+  const int level = s.level_at(-3.0);
+  std::vector<geom::detail::CellMask> masks(s.cell_count());
+  std::vector<std::pair<int, double>> crossings;
+  const auto xs = borders(s, true), ys = borders(s, false);
+  const geom::detail::LevelMaterial m(s, level, xs, ys, masks, crossings);
+  EXPECT_TRUE(m.may_meet(std::vector<SectionPoint>{{10, 10}, {12, 10}, {11, -1e15}}));
+  EXPECT_TRUE(m.may_meet(std::vector<SectionPoint>{{10, 10}, {12, 10}, {1e300, 11}}));
+  EXPECT_TRUE(m.may_meet(std::vector<SectionPoint>{{10, 10}, {12, 10}, {11, std::nan("")}}));
+  // The same triangle with a near apex is decided by the masks: inside the stock it meets
+  // material, beside it it does not.
+  EXPECT_TRUE(m.may_meet(std::vector<SectionPoint>{{10, 10}, {12, 10}, {11, 12}}));
+  EXPECT_FALSE(m.may_meet(std::vector<SectionPoint>{{50, 10}, {52, 10}, {51, 12}}));
+}
+
 TEST(CellMask, TiltedPassOverAPocketLeavesTheSolidOfThePassCutFirst) {
   // A tilted ball pass (the axis turning by 20° about X) half over a pocket: cut after the
   // pocket, its pieces over the pocket are in air and not built, and its arcs there are not

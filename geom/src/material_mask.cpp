@@ -160,12 +160,21 @@ LevelMaterial::LevelMaterial(const LbrSolid& solid, int level, const std::vector
 }
 
 bool LevelMaterial::may_meet(std::span<const SectionPoint> poly) const {
-  if (masks_.size() != s_.cell_count()) return true;
-  Rect pb;  // the polygon's box [units], rounded outwards
+  if (masks_.size() != s_.cell_count() || poly.empty()) return true;
+  // A polygon beyond the kernel's coordinate range (a cap triangle of almost parallel support
+  // lines has a far apex), or with a point that is not finite, may meet anything.
+  constexpr double kFarMm = 1e9;
+  double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
   for (const SectionPoint& q : poly) {
-    pb.add(Point{static_cast<Coord>(std::floor(q.x * kUnitsPerMm)), static_cast<Coord>(std::floor(q.y * kUnitsPerMm))});
-    pb.add(Point{static_cast<Coord>(std::ceil(q.x * kUnitsPerMm)), static_cast<Coord>(std::ceil(q.y * kUnitsPerMm))});
+    xlo = std::min(xlo, q.x);
+    xhi = std::max(xhi, q.x);
+    ylo = std::min(ylo, q.y);
+    yhi = std::max(yhi, q.y);
   }
+  if (!(xlo >= -kFarMm && xhi <= kFarMm && ylo >= -kFarMm && yhi <= kFarMm)) return true;
+  Rect pb;  // the polygon's box [units], rounded outwards
+  pb.add(Point{static_cast<Coord>(std::floor(xlo * kUnitsPerMm)), static_cast<Coord>(std::floor(ylo * kUnitsPerMm))});
+  pb.add(Point{static_cast<Coord>(std::ceil(xhi * kUnitsPerMm)), static_cast<Coord>(std::ceil(yhi * kUnitsPerMm))});
   if (!pb.intersects(box)) return false;
   // The regions whose rectangles the box reaches (a box that starts on a border reaches the
   // region before it too).
