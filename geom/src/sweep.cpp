@@ -831,6 +831,28 @@ void upper_envelope(SectionScratch& sc) {
 
 }  // namespace
 
+// The last direction of the run of directions from k (which lies in a cap) that the same cap
+// wins whole: `start` for the start cap (h < b in both of its wedge's edge directions), else
+// the end cap (h >= b), with b the envelope's break beside the cap. The cap is an arc of the
+// circle: with a = π/n, h = cos(φ ∓ a)/cos a at the wedge's edges (φ = θ_k − θ_e), so the
+// start cap is φ in (α + a, 2π − α − a) and the end cap φ in [−α' + a, α' − a], α = acos(b
+// cos a). The arc's end on the grid is estimated from that and settled by cap() itself, in
+// which the run's directions lie up to where it stops (the grid's last direction at most).
+template <class Cap>
+int cap_run_end(int k, bool start, double b, int n, double ex, double ey, const Cap& cap) {
+  const int want = cap(k);
+  const double step = 2.0 * std::numbers::pi / n, a = std::numbers::pi / n;
+  const double alpha = std::acos(std::clamp(b * std::cos(a), -1.0, 1.0));
+  const double th_e = std::atan2(ey, ex);
+  double end = (start ? th_e + 2.0 * std::numbers::pi - alpha - a : th_e + alpha - a) / step;  // [grid steps]
+  if (!std::isfinite(end)) end = k;
+  end -= n * std::floor((end - k) / n);  // the arc's end at or after k, within one turn
+  int e = static_cast<int>(std::min<double>(n - 1, std::floor(end)));
+  while (e > k && cap(e) != want) --e;
+  while (e + 1 < n && cap(e + 1) == want) ++e;
+  return e;
+}
+
 // Hull of several n-gons on one angle grid whose centres lie on the line of motion (a ramp),
 // without sorting points. Disk d has centre c0 + s_d·e (e: unit horizontal direction of the
 // motion) and circumradius ρ_d. For a direction θ = θ_k + δ with |δ| <= π/n the support
@@ -880,33 +902,40 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
     }
     return lo;
   };
-  const double T = std::tan(std::numbers::pi / n);
+  const double T = sc.half_step_tan(n);
+  // Inside a cap one disk wins the whole wedge of direction k: piece(h) is m-1 exactly when
+  // br[m-1] <= h and 0 exactly when h < br[1], so the two searches are needed only between.
+  // cap(k): 0 or m-1 for such a wedge, -1 for one that needs the searches.
+  auto cap = [&](int k) {
+    const double ck = uc[k].x, sk = uc[k].y;
+    const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
+    const double hp = cphi + sphi * T, hm = cphi - sphi * T;
+    if (m == 1 || (hp < br[1] && hm < br[1])) return 0;
+    if (hp >= br[m - 1] && hm >= br[m - 1]) return m - 1;
+    return -1;
+  };
   sc.hull.clear();
   sc.hull_role.clear();
   sc.hull_grid.clear();
   int run_piece = -1, run_len = 0;
   for (int k = 0; k < n; ++k) {
     const double ck = uc[k].x, sk = uc[k].y;
-    const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
-    const double hp = cphi + sphi * T, hm = cphi - sphi * T;
-    // Inside a cap one disk wins the whole wedge: piece(h) is m-1 exactly when br[m-1] <= h
-    // and 0 exactly when h < br[1], so the two searches are needed only between.
-    int i0 = 0, i1 = 0;
-    if (m == 1 || (hp < br[1] && hm < br[1])) {
-      i0 = i1 = 0;
-    } else if (hp >= br[m - 1] && hm >= br[m - 1]) {
-      i0 = i1 = m - 1;
-    } else {
-      i0 = piece(hp);
-      i1 = piece(hm);
+    const int whole_cap = cap(k);
+    int i0 = whole_cap, i1 = whole_cap;
+    if (whole_cap < 0) {
+      const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
+      i0 = piece(cphi + sphi * T);
+      i1 = piece(cphi - sphi * T);
     }
     // ends_only: a run of directions that one end disk wins whole keeps its first and last
     // vertex (the caps' grid interval is all section_caps() needs of it).
     const bool whole = i0 == i1 && disks[env[i0]].role != 0;
     if (ends_only && whole && i0 == run_piece && run_len >= 2) {
+      const int last = whole_cap >= 0 ? cap_run_end(k, whole_cap == 0, br[whole_cap == 0 ? 1 : m - 1], n, ex, ey, cap) : k;
       const auto& d = disks[env[i0]];
-      sc.hull.back() = {d.x + d.r * ck, d.y + d.r * sk};
-      sc.hull_grid.back() = k;
+      sc.hull.back() = {d.x + d.r * uc[last].x, d.y + d.r * uc[last].y};
+      sc.hull_grid.back() = last;
+      k = last;
       continue;
     }
     run_len = !whole ? 0 : i0 == run_piece ? run_len + 1 : 1;
@@ -1065,7 +1094,10 @@ bool trim_covered(Path& b, const Capsule& a, std::vector<std::uint8_t>& flags, d
 }
 
 const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {
-  if (static_cast<std::size_t>(n) >= circles_.size()) circles_.resize(static_cast<std::size_t>(n) + 1);
+  if (static_cast<std::size_t>(n) >= circles_.size()) {
+    circles_.resize(static_cast<std::size_t>(n) + 1);
+    half_step_tans_.resize(static_cast<std::size_t>(n) + 1);
+  }
   auto& c = circles_[static_cast<std::size_t>(n)];
   if (c.empty()) {
     c.resize(static_cast<std::size_t>(n));
@@ -1073,8 +1105,14 @@ const std::vector<SectionScratch::P2>& SectionScratch::unit_circle(int n) {
       const double a = 2.0 * std::numbers::pi * k / n;
       c[static_cast<std::size_t>(k)] = {std::cos(a), std::sin(a)};
     }
+    half_step_tans_[static_cast<std::size_t>(n)] = std::tan(std::numbers::pi / n);
   }
   return c;
+}
+
+double SectionScratch::half_step_tan(int n) {
+  (void)unit_circle(n);
+  return half_step_tans_[static_cast<std::size_t>(n)];
 }
 
 namespace {

@@ -152,16 +152,15 @@ CutterShape CutterShape::build(const Tool& tool, double chord_tol_mm) {
 
 double CutterShape::radius_at(double h) const noexcept {
   if (h < 0.0 || h > stations.back().h) return 0.0;
-  // Few stations (tens): a linear scan is cheaper than a binary search here.
-  for (std::size_t i = 1; i < stations.size(); ++i) {
-    if (h <= stations[i].h) {
-      const Station& a = stations[i - 1];
-      const Station& b = stations[i];
-      const double t = (h - a.h) / (b.h - a.h);
-      return a.r + t * (b.r - a.r);
-    }
-  }
-  return stations.back().r;
+  if (stations.size() < 2) return stations.back().r;
+  // The first station at or above h, after the tip's (tens of stations: a binary search takes
+  // half the instructions of a linear scan on finish3d's ball).
+  const auto it = std::lower_bound(stations.begin() + 1, stations.end(), h, [](const Station& st, double v) { return st.h < v; });
+  if (it == stations.end()) return stations.back().r;
+  const Station& a = *(it - 1);
+  const Station& b = *it;
+  const double t = (h - a.h) / (b.h - a.h);
+  return a.r + t * (b.r - a.r);
 }
 
 }  // namespace lbr::geom

@@ -127,9 +127,12 @@ struct SectionScratch {
   }
   // Unit circle with n vertices, (cos, sin) pairs, built on first use of each n.
   [[nodiscard]] const std::vector<P2>& unit_circle(int n);
+  // tan(π/n), the half grid step's tangent, kept with the unit circle of n.
+  [[nodiscard]] double half_step_tan(int n);
 
  private:
   std::vector<std::vector<P2>> circles_;
+  std::vector<double> half_step_tans_;
 };
 
 // The section of one vertical move on one plane, split for joining consecutive moves into
