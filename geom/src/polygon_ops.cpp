@@ -259,23 +259,36 @@ void append_crossings(const Point& a, const Point& b, std::span<const Coord> xs,
   }
 }
 
-// Some line lies strictly between lo and hi.
-bool spans_line(std::span<const Coord> lines, Coord lo, Coord hi) noexcept {
-  const auto it = std::upper_bound(lines.begin(), lines.end(), lo);
-  return it != lines.end() && *it < hi;
+// The lines strictly between lo and hi.
+std::span<const Coord> lines_between(std::span<const Coord> lines, Coord lo, Coord hi) noexcept {
+  const auto first = std::upper_bound(lines.begin(), lines.end(), lo);
+  const auto last = std::lower_bound(first, lines.end(), hi);
+  return {first, last};
+}
+
+// Some line of a path's few (lines_between()) lies strictly between a and b.
+bool edge_spans(std::span<const Coord> lines, Coord a, Coord b) noexcept {
+  const Coord lo = std::min(a, b), hi = std::max(a, b);
+  for (const Coord l : lines)
+    if (lo < l && l < hi) return true;
+  return false;
 }
 
 }  // namespace
 
 void split_at_lines(Path& path, std::span<const Coord> xs, std::span<const Coord> ys, Path& tmp) {
   if (path.size() < 2) return;
-  const Rect b = bounds_of(path);
-  if (!spans_line(xs, b.x0, b.x1) && !spans_line(ys, b.y0, b.y1)) return;
+  const Rect box = bounds_of(path);
+  // Only the lines inside the path's box can lie strictly between an edge's ends: each edge
+  // looks at those (mostly one) instead of searching all the borders.
+  const std::span<const Coord> in_x = lines_between(xs, box.x0, box.x1), in_y = lines_between(ys, box.y0, box.y1);
+  if (in_x.empty() && in_y.empty()) return;
   tmp.clear();
   for (std::size_t i = 0; i < path.size(); ++i) {
     const Point& a = path[i];
+    const Point& b = path[i + 1 < path.size() ? i + 1 : 0];
     tmp.push_back(a);
-    append_crossings(a, path[i + 1 < path.size() ? i + 1 : 0], xs, ys, tmp);
+    if (edge_spans(in_x, a.X, b.X) || edge_spans(in_y, a.Y, b.Y)) append_crossings(a, b, in_x, in_y, tmp);
   }
   path.assign(tmp.begin(), tmp.end());  // (not a swap: the scratch buffer keeps its capacity)
 }
