@@ -40,6 +40,12 @@ bool spin_until(Pred pred) {
   }
 }
 
+// A thread waiting at the barrier spins this often, then yields this often, then sleeps
+// kBarrierNap at a time (a wait of about a millisecond or more).
+constexpr unsigned kBarrierSpins = 4096;
+constexpr unsigned kBarrierYields = 1024;
+constexpr auto kBarrierNap = std::chrono::microseconds(50);
+
 }  // namespace
 
 class ParallelSubtractor::Impl {
@@ -138,9 +144,14 @@ void ParallelSubtractor::Impl::barrier() noexcept {
     phase_.fetch_add(1, std::memory_order_release);
     return;
   }
+  // Spin, then yield (more threads than cores), then sleep: a SCHED_FIFO thread that only
+  // yields never lets a SCHED_OTHER thread of its core run, which starves whatever the
+  // late thread may wait for (a writer holding a lock) until the kernel's RT throttling
+  // steps in, after up to a second.
   for (unsigned i = 0; phase_.load(std::memory_order_acquire) == phase; ++i) {
-    if (i < 4096) detail::cpu_relax();
-    else std::this_thread::yield();  // more threads than cores
+    if (i < kBarrierSpins) detail::cpu_relax();
+    else if (i < kBarrierSpins + kBarrierYields) std::this_thread::yield();
+    else std::this_thread::sleep_for(kBarrierNap);
   }
 }
 
