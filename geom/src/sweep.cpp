@@ -832,15 +832,15 @@ void upper_envelope(SectionScratch& sc) {
 }  // namespace
 
 // The last direction of the run of directions from k (which lies in a cap) that the same cap
-// wins whole: `start` for the start cap (h < b in both of its wedge's edge directions), else
-// the end cap (h >= b), with b the envelope's break beside the cap. The cap is an arc of the
+// wins whole: `want` is cap(k), 0 for the start cap (h < b at both of its wedge's edges),
+// else the end cap (h >= b), with b the envelope's break beside the cap. The cap is an arc of the
 // circle: with a = π/n, h = cos(φ ∓ a)/cos a at the wedge's edges (φ = θ_k − θ_e), so the
 // start cap is φ in (α + a, 2π − α − a) and the end cap φ in [−α' + a, α' − a], α = acos(b
 // cos a). The arc's end on the grid is estimated from that and settled by cap() itself, in
 // which the run's directions lie up to where it stops (the grid's last direction at most).
 template <class Cap>
-int cap_run_end(int k, bool start, double b, int n, double ex, double ey, const Cap& cap) {
-  const int want = cap(k);
+int cap_run_end(int k, int want, double b, int n, double ex, double ey, const Cap& cap) {
+  const bool start = want == 0;
   const double step = 2.0 * std::numbers::pi / n, a = std::numbers::pi / n;
   const double alpha = std::acos(std::clamp(b * std::cos(a), -1.0, 1.0));
   const double th_e = std::atan2(ey, ex);
@@ -905,33 +905,44 @@ void Sweep::ramp_hull(SectionScratch& sc, int n, double grow, const std::vector<
   const double T = sc.half_step_tan(n);
   // Inside a cap one disk wins the whole wedge of direction k: piece(h) is m-1 exactly when
   // br[m-1] <= h and 0 exactly when h < br[1], so the two searches are needed only between.
-  // cap(k): 0 or m-1 for such a wedge, -1 for one that needs the searches.
-  auto cap = [&](int k) {
+  // wedge(k): h at the two edges of direction k's wedge; cap_of(): 0 or m-1 for a wedge one
+  // cap wins whole, -1 for one that needs the searches.
+  struct Wedge {
+    double hp, hm;
+  };
+  auto wedge = [&](int k) {
     const double ck = uc[k].x, sk = uc[k].y;
     const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
-    const double hp = cphi + sphi * T, hm = cphi - sphi * T;
-    if (m == 1 || (hp < br[1] && hm < br[1])) return 0;
-    if (hp >= br[m - 1] && hm >= br[m - 1]) return m - 1;
+    return Wedge{cphi + sphi * T, cphi - sphi * T};
+  };
+  auto cap_of = [&](const Wedge& w) {
+    if (m == 1 || (w.hp < br[1] && w.hm < br[1])) return 0;
+    if (w.hp >= br[m - 1] && w.hm >= br[m - 1]) return m - 1;
     return -1;
   };
+  auto cap = [&](int k) { return cap_of(wedge(k)); };
   sc.hull.clear();
   sc.hull_role.clear();
   sc.hull_grid.clear();
   int run_piece = -1, run_len = 0;
   for (int k = 0; k < n; ++k) {
     const double ck = uc[k].x, sk = uc[k].y;
-    const int whole_cap = cap(k);
+    const Wedge w = wedge(k);
+    const int whole_cap = cap_of(w);
     int i0 = whole_cap, i1 = whole_cap;
     if (whole_cap < 0) {
-      const double cphi = ck * ex + sk * ey, sphi = sk * ex - ck * ey;
-      i0 = piece(cphi + sphi * T);
-      i1 = piece(cphi - sphi * T);
+      i0 = piece(w.hp);
+      i1 = piece(w.hm);
     }
     // ends_only: a run of directions that one end disk wins whole keeps its first and last
     // vertex (the caps' grid interval is all section_caps() needs of it).
     const bool whole = i0 == i1 && disks[env[i0]].role != 0;
     if (ends_only && whole && i0 == run_piece && run_len >= 2) {
-      const int last = whole_cap >= 0 ? cap_run_end(k, whole_cap == 0, br[whole_cap == 0 ? 1 : m - 1], n, ex, ey, cap) : k;
+      // With one envelope piece (m == 1) that piece wins every direction: the run goes to the
+      // grid's end (and br[1] does not exist).
+      const int last = whole_cap < 0 ? k
+                       : m == 1      ? n - 1
+                                     : cap_run_end(k, whole_cap, whole_cap == 0 ? br[1] : br[m - 1], n, ex, ey, cap);
       const auto& d = disks[env[i0]];
       sc.hull.back() = {d.x + d.r * uc[last].x, d.y + d.r * uc[last].y};
       sc.hull_grid.back() = last;

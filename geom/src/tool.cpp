@@ -153,8 +153,8 @@ CutterShape CutterShape::build(const Tool& tool, double chord_tol_mm) {
 double CutterShape::radius_at(double h) const noexcept {
   if (h < 0.0 || h > stations.back().h) return 0.0;
   if (stations.size() < 2) return stations.back().r;
-  // The first station at or above h, after the tip's (tens of stations: a binary search takes
-  // half the instructions of a linear scan on finish3d's ball).
+  // The first station at or above h, after the tip's (a binary search: on finish3d's ball,
+  // 0.159 G instructions against the linear scan's 0.179 G).
   const auto it = std::lower_bound(stations.begin() + 1, stations.end(), h, [](const Station& st, double v) { return st.h < v; });
   if (it == stations.end()) return stations.back().r;
   const Station& a = *(it - 1);
