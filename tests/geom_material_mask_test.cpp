@@ -163,7 +163,10 @@ TEST(CellMask, TiltedPassOverAPocketLeavesTheSolidOfThePassCutFirst) {
   std::printf("pass after the pocket: %llu pieces in air; before it: %llu; removed %.6f and %.6f mm3\n",
               static_cast<unsigned long long>(st.tilted_in_air), static_cast<unsigned long long>(sb.tilted_in_air),
               test::removed(after), test::removed(before));
-  EXPECT_GT(st.tilted_in_air, 500u);
+  // Pieces whose hull lies beside the material box of the regions the pass reaches are not
+  // even made (Sweep::tilted_pieces()); of the rest, those over the pocket are in air (more
+  // than 500 when the box was the whole level's, 180 with the reached regions' box).
+  EXPECT_GT(st.tilted_in_air, 100u);
   EXPECT_LT(sb.tilted_in_air, st.tilted_in_air / 10);
   EXPECT_GT(test::removed(after), test::kPocketVolume);
   EXPECT_NEAR(test::removed(after), test::removed(before), 0.05);

@@ -246,6 +246,23 @@ void plan_moves(SubtractShared& sh, double z_top, double& zlo, double& zhi) {
 
 }  // namespace
 
+// The regions the boxes of the batch's tilted sweeps reach, each box grown by a millimetre
+// and a region taken where the box reaches its border (the material a tilted piece may meet
+// lies in them: LevelMaterial); empty without tilted sweeps.
+RegionRange SubtractEngine::tilted_regions(const SubtractShared& sh) const noexcept {
+  Box3 b;
+  for (const Sweep& w : sh.sweeps)
+    if (!w.vertical()) b.add(w.bounds().lo), b.add(w.bounds().hi);
+  if (b.empty()) return RegionRange{};
+  constexpr double kGrowMm = 1.0;
+  auto units = [](double mm, double grow) {
+    const double u = std::clamp((mm + grow) * kUnitsPerMm, -4e18, 4e18);
+    return static_cast<Coord>(grow < 0 ? std::floor(u) : std::ceil(u));
+  };
+  return RegionRange{interval_of(s_.xs_, units(b.lo.x, -kGrowMm) - 1), interval_of(s_.xs_, units(b.hi.x, kGrowMm)),
+                     interval_of(s_.ys_, units(b.lo.y, -kGrowMm) - 1), interval_of(s_.ys_, units(b.hi.y, kGrowMm))};
+}
+
 int interval_of(const std::vector<Coord>& b, Coord v) noexcept {
   const auto it = std::upper_bound(b.begin(), b.end(), v);
   const long i = static_cast<long>(it - b.begin()) - 1;
@@ -257,7 +274,8 @@ void SubtractEngine::prepare(std::span<const SweepRef> batch, SubtractShared& sh
   reset_level_last();
   double zlo = INFINITY, zhi = -INFINITY;
   plan_moves(sh, s_.z_top_mm(), zlo, zhi);
-  reset_cell_masks(std::any_of(sh.sweeps.begin(), sh.sweeps.end(), [](const Sweep& w) { return !w.vertical(); }));
+  sh.tilted_regions = tilted_regions(sh);
+  reset_cell_masks(sh.tilted_regions.ix1 >= sh.tilted_regions.ix0);
   const bool nothing =
       (sh.sweeps.empty() && sh.lathe.empty() && sh.chain_count == 0) || zhi < s_.z0_ || zlo > s_.z1_;
   sh.lb = nothing ? 0 : s_.level_at(zlo);

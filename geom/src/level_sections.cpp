@@ -67,7 +67,7 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
   // The material of this level before the batch (the cells' boxes and masks): tilted
   // sub-steps beside it are not built, and pieces whose sections miss it are marked in_air
   // (Sweep::tilted_pieces()).
-  const LevelMaterial material(s_, level, s_.xs_, s_.ys_, s_.ws_->masks, ws.mask_crossings);
+  const LevelMaterial material(s_, level, s_.xs_, s_.ys_, s_.ws_->masks, ws.mask_crossings, sh.tilted_regions);
   for (const auto& run : sh.runs) build_run_sections(zc, run, material, sh, ws, ls, stats);
   ls.chain.assign(ls.paths.size(), kNoChain);
   ls.reach_begin.resize(ls.paths.size(), kNoReach);  // tilted sections: none

@@ -154,9 +154,11 @@ bool CellMask::may_meet(std::span<const SectionPoint> poly) const noexcept {
 }
 
 LevelMaterial::LevelMaterial(const LbrSolid& solid, int level, const std::vector<Coord>& xs, const std::vector<Coord>& ys,
-                             std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings) noexcept
+                             std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings,
+                             const RegionRange& regions) noexcept
     : s_(solid), level_(level), xs_(xs), ys_(ys), masks_(masks), crossings_(crossings) {
-  for (int r = 0; r < solid.regions(); ++r) box.add(solid.cell(r, level).bbox);
+  for (int iy = regions.iy0; iy <= regions.iy1; ++iy)
+    for (int ix = regions.ix0; ix <= regions.ix1; ++ix) box.add(solid.cell(iy * solid.regions_x() + ix, level).bbox);
 }
 
 bool LevelMaterial::may_meet(std::span<const SectionPoint> poly) const {

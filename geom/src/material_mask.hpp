@@ -58,10 +58,25 @@ class CellMask {
 // is clear. It is rebuilt only when it does not clear one. Region borders, cells and masks
 // are the solid's; `crossings` is the calling thread's buffer. Only the thread that builds
 // the level may use it.
+//
+// `box` is the box of the cells of `regions` (inclusive region indices; all of them by
+// default): the caller passes the regions its polygons can reach (the batch's tilted sweeps),
+// so the box holds all the material those polygons may meet. A live call's few sweeps reach
+// a handful of a 16x16 grid's 256 regions, and reading every cell of the level cost 3.3 % of
+// such calls' instructions (docs/performance.md, "Live calls: the level's material box").
+struct RegionRange {
+  int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // empty: ix1 < ix0
+  [[nodiscard]] static RegionRange all(const LbrSolid& s) noexcept { return {0, s.regions_x() - 1, 0, s.regions_y() - 1}; }
+};
+
 class LevelMaterial final : public PlaneMaterial {
  public:
   LevelMaterial(const LbrSolid& solid, int level, const std::vector<Coord>& xs, const std::vector<Coord>& ys,
-                std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings) noexcept;
+                std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings) noexcept
+      : LevelMaterial(solid, level, xs, ys, masks, crossings, RegionRange::all(solid)) {}
+  LevelMaterial(const LbrSolid& solid, int level, const std::vector<Coord>& xs, const std::vector<Coord>& ys,
+                std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings,
+                const RegionRange& regions) noexcept;
   [[nodiscard]] bool may_meet(std::span<const SectionPoint> poly) const override;
 
  private:

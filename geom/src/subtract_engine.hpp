@@ -65,6 +65,7 @@ class SubtractEngine {
   // The solid's cell masks (SubtractWorkspace::masks), sized when `tilted` (the batch has a
   // tilted sweep) and forgotten when material was put back; on the preparing thread.
   void reset_cell_masks(bool tilted) const;
+  [[nodiscard]] RegionRange tilted_regions(const SubtractShared& sh) const noexcept;
   [[nodiscard]] const TiltedPiece* level_prior(std::size_t level) const;
   static void join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats);
   static void add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls);

@@ -78,6 +78,7 @@ struct SubtractShared {
   std::vector<OffsetKey> offset_keys;      // the batch's distinct (chain, radius), in order
   std::vector<std::uint32_t> offset_of;    // per (level - lb, chain): index into offset_keys, or ~0
   int lb = 0, le = 0;                      // the levels the batch reaches: [lb, le)
+  RegionRange tilted_regions;              // the regions its tilted sweeps' boxes reach (LevelMaterial)
   // The regions' inner borders (the solid's xs_/ys_ without the first and last): sections
   // and offsets get a vertex where they cross one (split_at_lines()).
   std::span<const Coord> border_x, border_y;
