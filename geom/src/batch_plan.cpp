@@ -254,6 +254,8 @@ RegionRange SubtractEngine::tilted_regions(const SubtractShared& sh) const noexc
   for (const Sweep& w : sh.sweeps)
     if (!w.vertical()) b.add(w.bounds().lo), b.add(w.bounds().hi);
   if (b.empty()) return RegionRange{};
+  if (!(std::isfinite(b.lo.x) && std::isfinite(b.lo.y) && std::isfinite(b.hi.x) && std::isfinite(b.hi.y)))
+    return RegionRange::all(s_);  // a box that is not finite reaches everything
   constexpr double kGrowMm = 1.0;
   auto units = [](double mm, double grow) {
     const double u = std::clamp((mm + grow) * kUnitsPerMm, -4e18, 4e18);
