@@ -202,6 +202,7 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
   j["sections_trimmed"] = r.stats.sections_trimmed;
   j["sections_in_air"] = r.stats.sections_in_air;
   j["tilted_in_air"] = r.stats.tilted_in_air;
+  j["tilted_beside"] = r.stats.tilted_beside;
   j["sections_joined"] = r.stats.sections_joined;
   j["outlines_star"] = r.stats.outlines_star;
   j["cells_out_of_reach"] = r.stats.cells_out_of_reach;

@@ -257,12 +257,8 @@ RegionRange SubtractEngine::tilted_regions(const SubtractShared& sh) const noexc
   if (!(std::isfinite(b.lo.x) && std::isfinite(b.lo.y) && std::isfinite(b.hi.x) && std::isfinite(b.hi.y)))
     return RegionRange::all(s_);  // a box that is not finite reaches everything
   constexpr double kGrowMm = 1.0;
-  auto units = [](double mm, double grow) {
-    const double u = std::clamp((mm + grow) * kUnitsPerMm, -4e18, 4e18);
-    return static_cast<Coord>(grow < 0 ? std::floor(u) : std::ceil(u));
-  };
-  return RegionRange{interval_of(s_.xs_, units(b.lo.x, -kGrowMm) - 1), interval_of(s_.xs_, units(b.hi.x, kGrowMm)),
-                     interval_of(s_.ys_, units(b.lo.y, -kGrowMm) - 1), interval_of(s_.ys_, units(b.hi.y, kGrowMm))};
+  return regions_reached(s_.xs_, s_.ys_,
+                         units_box_outward(b.lo.x - kGrowMm, b.lo.y - kGrowMm, b.hi.x + kGrowMm, b.hi.y + kGrowMm));
 }
 
 int interval_of(const std::vector<Coord>& b, Coord v) noexcept {
@@ -277,7 +273,7 @@ void SubtractEngine::prepare(std::span<const SweepRef> batch, SubtractShared& sh
   double zlo = INFINITY, zhi = -INFINITY;
   plan_moves(sh, s_.z_top_mm(), zlo, zhi);
   sh.tilted_regions = tilted_regions(sh);
-  reset_cell_masks(sh.tilted_regions.ix1 >= sh.tilted_regions.ix0);
+  reset_cell_masks(!sh.tilted_regions.empty());
   const bool nothing =
       (sh.sweeps.empty() && sh.lathe.empty() && sh.chain_count == 0) || zhi < s_.z0_ || zlo > s_.z1_;
   sh.lb = nothing ? 0 : s_.level_at(zlo);

@@ -226,7 +226,7 @@ void SubtractEngine::build_run_sections(double zc, std::pair<std::uint32_t, std:
     }
     if (!sw.vertical()) {
       const std::size_t before = ws.pieces.size();
-      sw.tilted_pieces(zc, ws.pieces, &material);
+      sw.tilted_pieces(zc, ws.pieces, &material, &stats.tilted_beside);
       for (std::size_t k = before; k < ws.pieces.size(); ++k) ws.pieces[k].sweep = si;
       ++si;
       continue;

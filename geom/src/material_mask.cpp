@@ -153,6 +153,22 @@ bool CellMask::may_meet(std::span<const SectionPoint> poly) const noexcept {
   return false;
 }
 
+Rect units_box_outward(double xlo, double ylo, double xhi, double yhi) noexcept {
+  static constexpr double kFarUnits = 4e18;  // well inside Coord's range
+  auto units = [](double mm, bool up) {
+    const double u = std::clamp(mm * kUnitsPerMm, -kFarUnits, kFarUnits);
+    return static_cast<Coord>(up ? std::ceil(u) : std::floor(u));
+  };
+  Rect r;
+  r.add(Point{units(xlo, false), units(ylo, false)});
+  r.add(Point{units(xhi, true), units(yhi, true)});
+  return r;
+}
+
+RegionRange regions_reached(const std::vector<Coord>& xs, const std::vector<Coord>& ys, const Rect& b) noexcept {
+  return RegionRange{interval_of(xs, b.x0 - 1), interval_of(xs, b.x1), interval_of(ys, b.y0 - 1), interval_of(ys, b.y1)};
+}
+
 LevelMaterial::LevelMaterial(const LbrSolid& solid, int level, const std::vector<Coord>& xs, const std::vector<Coord>& ys,
                              std::vector<CellMask>& masks, std::vector<std::pair<int, double>>& crossings,
                              const RegionRange& regions) noexcept
@@ -174,17 +190,12 @@ bool LevelMaterial::may_meet(std::span<const SectionPoint> poly) const {
     yhi = std::max(yhi, q.y);
   }
   if (!(xlo >= -kFarMm && xhi <= kFarMm && ylo >= -kFarMm && yhi <= kFarMm)) return true;
-  Rect pb;  // the polygon's box [units], rounded outwards
-  pb.add(Point{static_cast<Coord>(std::floor(xlo * kUnitsPerMm)), static_cast<Coord>(std::floor(ylo * kUnitsPerMm))});
-  pb.add(Point{static_cast<Coord>(std::ceil(xhi * kUnitsPerMm)), static_cast<Coord>(std::ceil(yhi * kUnitsPerMm))});
+  const Rect pb = units_box_outward(xlo, ylo, xhi, yhi);
   if (!pb.intersects(box)) return false;
-  // The regions whose rectangles the box reaches (a box that starts on a border reaches the
-  // region before it too).
-  const int ix0 = interval_of(xs_, pb.x0 - 1), ix1 = interval_of(xs_, pb.x1);
-  const int iy0 = interval_of(ys_, pb.y0 - 1), iy1 = interval_of(ys_, pb.y1);
+  const RegionRange rr = regions_reached(xs_, ys_, pb);
   const auto levels = static_cast<std::size_t>(s_.levels());
-  for (int iy = iy0; iy <= iy1; ++iy)
-    for (int ix = ix0; ix <= ix1; ++ix) {
+  for (int iy = rr.iy0; iy <= rr.iy1; ++iy)
+    for (int ix = rr.ix0; ix <= rr.ix1; ++ix) {
       const int region = iy * s_.regions_x() + ix;
       const Cell& c = s_.cell(region, level_);
       if (!c.bbox.intersects(pb)) continue;

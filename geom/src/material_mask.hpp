@@ -51,6 +51,20 @@ class CellMask {
   double sx_ = 0.0, sy_ = 0.0;  // pixels per unit
 };
 
+// A block of regions of a solid's grid: inclusive region indices along x and y.
+struct RegionRange {
+  int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // empty: ix1 < ix0
+  [[nodiscard]] bool empty() const noexcept { return ix1 < ix0 || iy1 < iy0; }
+  [[nodiscard]] static RegionRange all(const LbrSolid& s) noexcept { return {0, s.regions_x() - 1, 0, s.regions_y() - 1}; }
+};
+
+// The box [units] of the rectangle [xlo, xhi] x [ylo, yhi] [mm], rounded outwards (and
+// clamped far inside Coord's range). The bounds must not be NaN.
+[[nodiscard]] Rect units_box_outward(double xlo, double ylo, double xhi, double yhi) noexcept;
+// The regions of borders `xs`, `ys` [units] (interval_of()) that box `b` [units] reaches; a
+// box that starts on a border reaches the region before it too.
+[[nodiscard]] RegionRange regions_reached(const std::vector<Coord>& xs, const std::vector<Coord>& ys, const Rect& b) noexcept;
+
 // The material of one level before a batch, for Sweep::tilted_pieces(): the box of its
 // cells, and their masks. A subtraction only removes material, and the masks are forgotten
 // whenever the solid may have had material put back (its removal epoch), so a mask built
@@ -59,16 +73,11 @@ class CellMask {
 // are the solid's; `crossings` is the calling thread's buffer. Only the thread that builds
 // the level may use it.
 //
-// `box` is the box of the cells of `regions` (inclusive region indices; all of them by
-// default): the caller passes the regions its polygons can reach (the batch's tilted sweeps),
-// so the box holds all the material those polygons may meet. A live call's few sweeps reach
-// a handful of a 16x16 grid's 256 regions, and reading every cell of the level cost 3.3 % of
-// such calls' instructions (docs/performance.md, "Live calls: the level's material box").
-struct RegionRange {
-  int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;  // empty: ix1 < ix0
-  [[nodiscard]] static RegionRange all(const LbrSolid& s) noexcept { return {0, s.regions_x() - 1, 0, s.regions_y() - 1}; }
-};
-
+// `box` is the box of the cells of `regions` (all of them by default): the caller passes the
+// regions its polygons can reach (the batch's tilted sweeps), so the box holds all the
+// material those polygons may meet. A live call's few sweeps reach a handful of a 16x16
+// grid's 256 regions, and reading every cell of the level cost 3.3 % of such calls'
+// instructions (docs/performance.md, "Live calls: the level's material box").
 class LevelMaterial final : public PlaneMaterial {
  public:
   LevelMaterial(const LbrSolid& solid, int level, const std::vector<Coord>& xs, const std::vector<Coord>& ys,

@@ -1546,7 +1546,8 @@ bool TiltedPiece::axis_box(SectionScratch::P2 (&out)[4]) const noexcept {
   return true;
 }
 
-std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const PlaneMaterial* material) const {
+std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const PlaneMaterial* material,
+                                 std::uint64_t* beside) const {
   if (vertical_ || zc < box_.lo.z || zc > box_.hi.z) return 0;
   const CutterShape& s = *shape_;
   if (s.stations.size() > kMaxStations) return 0;
@@ -1563,7 +1564,10 @@ std::size_t Sweep::tilted_pieces(double zc, std::vector<TiltedPiece>& out, const
     HullBox hb;
     substep_extent(s, hull, pa, b, top_, zlo, zhi, material != nullptr ? &hb : nullptr);
     if (zc < zlo || zc > zhi) continue;
-    if (material != nullptr && beside_material(hull, hb, material->box)) continue;
+    if (material != nullptr && beside_material(hull, hb, material->box)) {
+      if (beside != nullptr) ++*beside;
+      continue;
+    }
     const bool warm = !out.empty() && out.back().zc == zc;
     out.emplace_back();
     TiltedPiece& p = out.back();

@@ -135,6 +135,7 @@ struct SubtractStats {
   std::uint64_t clips_windowed = 0;      // clips fed the cell's contours reduced to the clip's window
   std::uint64_t window_fallbacks = 0;    // windowed clips done again with the whole contours
   std::uint64_t tilted_in_air = 0;       // tilted pieces not built: their section meets no material
+  std::uint64_t tilted_beside = 0;       // tilted pieces not made: their hull lies beside the level's material box
   SubtractStats& operator+=(const SubtractStats& o) noexcept {
     sections += o.sections; cells_tested += o.cells_tested;
     cells_clipped += o.cells_clipped; cells_changed += o.cells_changed;
@@ -143,7 +144,7 @@ struct SubtractStats {
     sections_joined += o.sections_joined; outlines_star += o.outlines_star;
     cells_out_of_reach += o.cells_out_of_reach;
     clips_windowed += o.clips_windowed; window_fallbacks += o.window_fallbacks;
-    tilted_in_air += o.tilted_in_air;
+    tilted_in_air += o.tilted_in_air; tilted_beside += o.tilted_beside;
     return *this;
   }
 };

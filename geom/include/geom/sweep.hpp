@@ -256,11 +256,12 @@ class Sweep {
 
   // Tilted sweeps only: appends to `out` one TiltedPiece per sub-step whose hull meets plane
   // z = z_mm and, when `material` is given, does not lie beside its box (as section());
-  // returns how many. With `material`, a piece's axis directions are searched first, and a
-  // piece whose axis box (TiltedPiece::axis_box()) does not meet `material` is marked in_air
-  // and has only those coarse points. Real-time safe once `out` has grown and when
-  // `material` is (or is null).
-  std::size_t tilted_pieces(double z_mm, std::vector<TiltedPiece>& out, const PlaneMaterial* material = nullptr) const;
+  // returns how many, and adds to `*beside` (when given) how many it left out beside the box.
+  // With `material`, a piece's axis directions are searched first, and a piece whose axis box
+  // (TiltedPiece::axis_box()) does not meet `material` is marked in_air and has only those
+  // coarse points. Real-time safe once `out` has grown and when `material` is (or is null).
+  std::size_t tilted_pieces(double z_mm, std::vector<TiltedPiece>& out, const PlaneMaterial* material = nullptr,
+                            std::uint64_t* beside = nullptr) const;
   // What a piece's refinement may leave out (build_piece()); every member may be null.
   struct PieceCovers {
     const TiltedPiece* before = nullptr;  // the piece before on the same plane
