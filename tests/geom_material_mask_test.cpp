@@ -176,3 +176,46 @@ TEST(CellMask, TiltedPassOverAPocketLeavesTheSolidOfThePassCutFirst) {
 }
 
 }  // namespace
+
+TEST(CellMask, RebuildsThatClearNothingBackOff) {
+  // A polygon in the middle of the material meets it whatever the mask's age, so rebuilding
+  // the mask for it after each small cut elsewhere in the cell clears nothing: the rebuilds
+  // come after 1, 2, 4, 8 and then every 16 changes of the cell. A rebuilt mask that clears
+  // a polygon ends the back-off.
+  geom::LbrSolid s(test::box_spec({0, 0, -10}, {20, 15, 0}, 0.5, 1, 1));
+  const auto flat = geom::CutterShape::build(test::tool(geom::ToolKind::Flat, 1), 0.01);
+  const int level = s.level_at(-3.0);
+  std::vector<geom::detail::CellMask> masks(s.cell_count());
+  std::vector<std::pair<int, double>> crossings;
+  const auto xs = borders(s, true), ys = borders(s, false);
+  const std::vector<SectionPoint> inside{{10, 10}, {12, 10}, {12, 12}, {10, 12}};
+  const geom::detail::CellMask& mask = masks[static_cast<std::size_t>(level)];
+  std::vector<std::uint32_t> built_at;  // the cell's versions the mask was built from
+  for (int i = 0; i < 40; ++i) {
+    const geom::detail::LevelMaterial m(s, level, xs, ys, masks, crossings);
+    EXPECT_TRUE(m.may_meet(inside));
+    if (built_at.empty() || built_at.back() != mask.version) built_at.push_back(mask.version);
+    const double x = 1.0 + 0.45 * i;
+    test::cut(s, flat, test::at(x, 3, -8), test::at(x + 0.1, 3, -8));
+  }
+  const std::uint32_t v0 = built_at.front();
+  std::vector<std::uint32_t> gaps;
+  for (std::size_t k = 1; k < built_at.size(); ++k) gaps.push_back(built_at[k] - built_at[k - 1]);
+  EXPECT_EQ(gaps, (std::vector<std::uint32_t>{1, 2, 4, 8, 16})) << "first build at version " << v0;
+  EXPECT_EQ(mask.misses, geom::detail::CellMask::kMaxMisses);
+  // Deep in the last hole (Ø1 at x = 18.55, 0.4 mm from its wall: more than a pixel of
+  // 0.3125 mm): a stale mask does not clear it, the rebuilt one does, and the next rebuild
+  // starts the back-off again.
+  const std::vector<SectionPoint> hole{{18.55, 2.95}, {18.65, 2.95}, {18.65, 3.05}, {18.55, 3.05}};
+  for (int i = 0; i < 16; ++i) test::cut(s, flat, test::at(1.0 + 0.45 * i, 13, -8), test::at(1.1 + 0.45 * i, 13, -8));
+  {
+    const geom::detail::LevelMaterial m(s, level, xs, ys, masks, crossings);
+    EXPECT_FALSE(m.may_meet(hole));
+    EXPECT_TRUE(mask.cleared);
+    EXPECT_EQ(mask.misses, geom::detail::CellMask::kMaxMisses);  // rebuilt, after a run that cleared nothing
+    test::cut(s, flat, test::at(10, 7, -8), test::at(10.1, 7, -8));
+    const geom::detail::LevelMaterial m2(s, level, xs, ys, masks, crossings);
+    EXPECT_TRUE(m2.may_meet(inside));  // a rebuild after one change: the mask had cleared the hole
+    EXPECT_EQ(mask.misses, 0);
+  }
+}

@@ -82,6 +82,8 @@ void CellMask::fill_rows(std::vector<std::pair<int, double>>& crossings) noexcep
 }
 
 void CellMask::build(const Cell& cell, const Rect& region, std::vector<std::pair<int, double>>& crossings) {
+  misses = !built || cleared ? 0 : static_cast<std::uint8_t>(std::min<int>(misses + 1, kMaxMisses));
+  cleared = false;
   version = cell.version;
   built = true;
   x0_ = static_cast<double>(region.x0);
@@ -201,10 +203,14 @@ bool LevelMaterial::may_meet(std::span<const SectionPoint> poly) const {
       if (!c.bbox.intersects(pb)) continue;
       CellMask& m = masks_[static_cast<std::size_t>(region) * levels + static_cast<std::size_t>(level_)];
       if (!m.built) m.build(c, s_.region_rect(region), crossings_);
-      if (!m.may_meet(poly)) continue;  // a mask built before later cuts holds more material: still clear
-      if (m.version == c.version) return true;
+      if (!m.may_meet(poly)) {  // a mask built before later cuts holds more material: still clear
+        m.cleared = true;
+        continue;
+      }
+      if (!m.rebuild_due(c.version)) return true;
       m.build(c, s_.region_rect(region), crossings_);
       if (m.may_meet(poly)) return true;
+      m.cleared = true;
     }
   return false;
 }
