@@ -175,8 +175,6 @@ TEST(CellMask, TiltedPassOverAPocketLeavesTheSolidOfThePassCutFirst) {
   EXPECT_EQ(after.check_invariants(), "");
 }
 
-}  // namespace
-
 TEST(CellMask, RebuildsThatClearNothingBackOff) {
   // A polygon in the middle of the material meets it whatever the mask's age, so rebuilding
   // the mask for it after each small cut elsewhere in the cell clears nothing: the rebuilds
@@ -203,19 +201,19 @@ TEST(CellMask, RebuildsThatClearNothingBackOff) {
   for (std::size_t k = 1; k < built_at.size(); ++k) gaps.push_back(built_at[k] - built_at[k - 1]);
   EXPECT_EQ(gaps, (std::vector<std::uint32_t>{1, 2, 4, 8, 16})) << "first build at version " << v0;
   EXPECT_EQ(mask.misses, geom::detail::CellMask::kMaxMisses);
-  // Deep in the last hole (Ø1 at x = 18.55, 0.4 mm from its wall: more than a pixel of
-  // 0.3125 mm): a stale mask does not clear it, the rebuilt one does, and the next rebuild
-  // starts the back-off again.
+  // In the slot the holes left, at its last one (x = 18.55, 0.45 mm from the slot's walls:
+  // more than a pixel of 0.3125 mm), cut after the mask's last build: only a rebuilt mask
+  // clears it, and the next rebuild starts the back-off again.
   const std::vector<SectionPoint> hole{{18.55, 2.95}, {18.65, 2.95}, {18.65, 3.05}, {18.55, 3.05}};
   for (int i = 0; i < 16; ++i) test::cut(s, flat, test::at(1.0 + 0.45 * i, 13, -8), test::at(1.1 + 0.45 * i, 13, -8));
-  {
-    const geom::detail::LevelMaterial m(s, level, xs, ys, masks, crossings);
-    EXPECT_FALSE(m.may_meet(hole));
-    EXPECT_TRUE(mask.cleared);
-    EXPECT_EQ(mask.misses, geom::detail::CellMask::kMaxMisses);  // rebuilt, after a run that cleared nothing
-    test::cut(s, flat, test::at(10, 7, -8), test::at(10.1, 7, -8));
-    const geom::detail::LevelMaterial m2(s, level, xs, ys, masks, crossings);
-    EXPECT_TRUE(m2.may_meet(inside));  // a rebuild after one change: the mask had cleared the hole
-    EXPECT_EQ(mask.misses, 0);
-  }
+  const geom::detail::LevelMaterial m(s, level, xs, ys, masks, crossings);
+  EXPECT_FALSE(m.may_meet(hole));
+  EXPECT_TRUE(mask.cleared);
+  EXPECT_EQ(mask.misses, geom::detail::CellMask::kMaxMisses);  // rebuilt, after a run that cleared nothing
+  test::cut(s, flat, test::at(10, 7, -8), test::at(10.1, 7, -8));
+  const geom::detail::LevelMaterial m2(s, level, xs, ys, masks, crossings);
+  EXPECT_TRUE(m2.may_meet(inside));  // a rebuild after one change: the mask had cleared the hole
+  EXPECT_EQ(mask.misses, 0);
 }
+
+}  // namespace

@@ -38,8 +38,8 @@ class CellMask {
   // True when some pixel that the convex polygon `poly` [mm] overlaps may hold material.
   [[nodiscard]] bool may_meet(std::span<const SectionPoint> poly) const noexcept;
   // Whether a polygon the mask does not clear is worth a rebuild from a cell at
-  // `cell_version`: the cell has changed since (2^misses times, kMaxMisses, unless the mask
-  // has cleared a polygon since it was built). Live calls cut a little at a time beside the
+  // `cell_version`: the cell has changed since the build at least 2^misses times (once when
+  // the mask has cleared a polygon since). Live calls cut a little at a time beside the
   // material: 99.9 % of rebuilds on finish5x's live stand-in still met the polygon
   // (docs/performance.md, "Mask rebuilds that clear nothing").
   [[nodiscard]] bool rebuild_due(std::uint32_t cell_version) const noexcept {
