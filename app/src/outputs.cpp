@@ -206,6 +206,7 @@ std::string batch_metrics_json(const BatchResult& r, const Profile& profile, con
   j["sections_joined"] = r.stats.sections_joined;
   j["outlines_star"] = r.stats.outlines_star;
   j["cells_out_of_reach"] = r.stats.cells_out_of_reach;
+  j["cells_in_anchor"] = r.stats.cells_in_anchor;
   j["clips_windowed"] = r.stats.clips_windowed;
   j["window_fallbacks"] = r.stats.window_fallbacks;
   j["chain_offsets"] = r.stats.chain_offsets;

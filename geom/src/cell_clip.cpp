@@ -215,6 +215,31 @@ bool add_windowed_subjects(const Cell& cell, const Rect& clip_box, SubtractWorks
   return true;
 }
 
+// True when every selected section, cut to ws.keep (the box of the material it may meet),
+// lies inside `anchor`, a piece already removed from the cell, grown by its band
+// (PriorPiece): the clip could remove material within the band of the sections' boundary
+// at most. A chain's offset is not tested (false).
+bool inside_anchor(const PriorPiece& anchor, const LevelSections& ls, SubtractWorkspace& ws) {
+  for (std::uint32_t k : ws.selected) {  // the boxes first: a batch's sections reach far beyond one piece
+    if (ls.chain[k] != kNoChain) return false;
+    const Rect& b = ls.box[k];
+    const Rect part{std::max(b.x0, ws.keep.x0), std::max(b.y0, ws.keep.y0), std::min(b.x1, ws.keep.x1),
+                    std::min(b.y1, ws.keep.y1)};
+    if (!anchor.box_holds(part)) return false;
+  }
+  for (std::uint32_t k : ws.selected) {
+    const Path& path = ls.paths[k];
+    const Path* cut = &path;
+    if (!contains(ws.keep, ls.box[k])) {
+      cut_to_rect(path, ws.keep, ws.cut, ws.cut_tmp);
+      cut = &ws.cut;
+    }
+    for (const Point& q : *cut)
+      if (!anchor.holds(q)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 // The difference of the touched polygons and the selected sections into ws.tree: with the
@@ -281,17 +306,25 @@ Rect SubtractEngine::add_clip_paths(int region, const LevelSections& ls, Subtrac
   return added;
 }
 
-// Clips one cell with the level's sections; true when the cell changed.
-bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
-                         SubtractStats& stats) {
+// Clips one cell with the level's sections. Unless the clip was left out inside the cell's
+// anchor, the cell has now had the level's newest anchor removed (LevelAnchors).
+CellOutcome SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh,
+                                      SubtractWorkspace& ws, SubtractStats& stats) {
   const std::size_t ci = static_cast<std::size_t>(region) * s_.levels_ + level;
+  const CellOutcome o = difference_cell(ci, region, ls, sh, ws, stats);
+  if (o != kCellInAnchor && ls.anchor != 0) s_.ws_->cell_anchor[ci] = ls.anchor;
+  return o;
+}
+
+CellOutcome SubtractEngine::difference_cell(std::size_t ci, int region, const LevelSections& ls, SubtractShared& sh,
+                                            SubtractWorkspace& ws, SubtractStats& stats) {
   Cell& cell = s_.cells_[ci];
-  if (!cell.bbox.intersects(ls.all)) return false;
+  if (!cell.bbox.intersects(ls.all)) return kCellKept;
   ++stats.cells_tested;
-  if (!select_for_cell(cell, ls, ws) || !drop_sections_in_air(cell, ls, ws, stats)) return false;
+  if (!select_for_cell(cell, ls, ws) || !drop_sections_in_air(cell, ls, ws, stats)) return kCellKept;
   if (material_out_of_reach(cell, ws.touched, ls, ws.selected, ws.reach)) {
     ++stats.cells_out_of_reach;
-    return false;
+    return kCellKept;
   }
 
   // What the sections may cut: the touched polygons within the sections' box.
@@ -300,16 +333,21 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
   const Rect m = material_box(cell, ws.touched, reach);
   if (m.empty()) {
     ++stats.cells_out_of_reach;
-    return false;
+    return kCellKept;
   }
   ws.keep = Rect{m.x0 - kKeepMarginUnits, m.y0 - kKeepMarginUnits, m.x1 + kKeepMarginUnits, m.y1 + kKeepMarginUnits};
+  if (const PriorPiece* anchor = ls.anchors->find(s_.ws_->cell_anchor[ci]);
+      anchor != nullptr && inside_anchor(*anchor, ls, ws)) {
+    ++stats.cells_in_anchor;
+    return kCellInAnchor;
+  }
   run_difference(cell, region, ls, sh, ws, stats);
   ++stats.cells_clipped;
   ws.fresh.clear();
   append_polygons(ws.tree, ws.fresh);
   keep_in_region(s_.region_rect(region), ws);
   drop_slivers(s_.region_rect(region), ws);
-  if (removes_only_noise(cell, ws) || !inherit_move_ids(cell, ls, ws)) return false;
+  if (removes_only_noise(cell, ws) || !inherit_move_ids(cell, ls, ws)) return kCellKept;
 
   replace_touched(cell, ws);
   refresh_cell(cell);
@@ -317,7 +355,7 @@ bool SubtractEngine::clip_cell(int region, int level, const LevelSections& ls, S
   for (std::uint32_t k : ws.selected) cell.last_cut = std::max(cell.last_cut, ls.id[k]);
   s_.changed(ci);
   ++stats.cells_changed;
-  return true;
+  return kCellChanged;
 }
 
 }  // namespace lbr::geom::detail

@@ -274,6 +274,67 @@ double max_dist_to_segment(V2 a, V2 b, double d2, V2 p) noexcept { return std::m
 
 }  // namespace
 
+void PriorPiece::add_plane(double nx, double ny, const Point& on, double band_units) {
+  planes_.push_back({nx, ny, nx * static_cast<double>(on.X) + ny * static_cast<double>(on.Y) + band_units});
+}
+
+bool PriorPiece::set(const Path& poly, double band_units) {
+  planes_.clear();
+  const std::size_t n = poly.size();
+  if (n < 3) return false;
+  auto normal = [&](std::size_t i, double& nx, double& ny) {  // edge i's outward unit normal, false if it has no length
+    const Point& a = poly[i];
+    const Point& b = poly[i + 1 == n ? 0 : i + 1];
+    const double ex = static_cast<double>(b.X - a.X), ey = static_cast<double>(b.Y - a.Y);
+    const double len = std::sqrt(ex * ex + ey * ey);
+    if (!(len > 0.0)) return false;
+    nx = ey / len, ny = -ex / len;  // counter-clockwise: the inside is on the left
+    return true;
+  };
+  double px = 0.0, py = 0.0;  // the previous edge's normal, first the last edge's
+  bool have = false;
+  for (std::size_t i = n; i-- > 0 && !have;) have = normal(i, px, py);
+  if (!have) return false;
+  constexpr double kStep = std::numbers::pi / 3.0;  // bevels: at most 60 degrees between planes
+  const double out = band_units * std::cos(kStep / 2.0);  // each plane's move: a corner reaches the band
+  Rect box;
+  double turned = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    double nx = 0.0, ny = 0.0;
+    if (!normal(i, nx, ny)) continue;
+    const Point& a = poly[i];
+    const double turn = std::atan2(px * ny - py * nx, px * nx + py * ny);  // at a; negative: a concave corner
+    if (turn < 0.0) {
+      planes_.clear();
+      return false;
+    }
+    turned += turn;
+    const int bevels = static_cast<int>(std::ceil(turn / kStep)) - 1;
+    const double from = std::atan2(py, px);
+    for (int k = 1; k <= bevels; ++k) {
+      const double t = from + turn * k / (bevels + 1);
+      add_plane(std::cos(t), std::sin(t), a, out);
+    }
+    add_plane(nx, ny, a, out);
+    box.add(a);
+    px = nx, py = ny;
+  }
+  if (planes_.size() < 3 || std::abs(turned - 2.0 * std::numbers::pi) > 1e-6) {  // once around: simple and convex
+    planes_.clear();
+    return false;
+  }
+  const auto grow = static_cast<Coord>(std::ceil(band_units)) + 1;
+  box_ = Rect{box.x0 - grow, box.y0 - grow, box.x1 + grow, box.y1 + grow};
+  return true;
+}
+
+bool PriorPiece::holds(const Point& q) const noexcept {
+  const double x = static_cast<double>(q.X), y = static_cast<double>(q.Y);
+  for (const Plane& p : planes_)
+    if (p.nx * x + p.ny * y > p.c) return false;
+  return true;
+}
+
 double reach_band_units(double chord_tol_mm) noexcept { return 2.0 * chord_tol_mm * kUnitsPerMm + 2.0; }
 
 void add_outline_reach(std::span<const MoveCaps> moves, double band_units, std::vector<ReachCapsule>& out) {

@@ -84,6 +84,40 @@ void add_chain_reach(const Path& pts, double r_mm, std::vector<ReachCapsule>& ou
 void add_section_reach(const Path& p, double ax_mm, double ay_mm, double bx_mm, double by_mm, double band_units,
                        std::vector<ReachCapsule>& out);
 
+// A tilted section that a batch subtracted from a cell (SubtractWorkspace::level_anchors):
+// its convex counter-clockwise polygon [units] as half-planes, each moved out by
+// band · cos 30°, with bevels where a corner turns by more than 60 degrees, so that the grown
+// region holds every point within band · cos 30° of the polygon and none farther than the
+// band. The cell holds no material inside the polygon (its clip removed it, or it was
+// noise), and material only goes, so a later section whose part near the cell's material
+// lies in the grown region can remove material within the band of its own boundary at most,
+// as a clip left out by material_out_of_reach() can. A live call's
+// short tilted sweep starts where the last one ended: in a quarter of its (cell, level) clips
+// the new section only grazes the previous one's walls (docs/performance.md, "Live clips
+// inside the removed piece").
+class PriorPiece {
+ public:
+  // From `poly` and the band [units]; false (and empty) unless `poly` is convex,
+  // counter-clockwise and has at least 3 vertices. Allocates while its buffer grows.
+  bool set(const Path& poly, double band_units);
+  void clear() noexcept { planes_.clear(); }
+  [[nodiscard]] bool empty() const noexcept { return planes_.empty(); }
+  // True when rectangle `r` lies within the box of the grown polygon.
+  [[nodiscard]] bool box_holds(const Rect& r) const noexcept {
+    return !empty() && r.x0 >= box_.x0 && r.y0 >= box_.y0 && r.x1 <= box_.x1 && r.y1 <= box_.y1;
+  }
+  // True when q lies inside the grown polygon.
+  [[nodiscard]] bool holds(const Point& q) const noexcept;
+
+ private:
+  struct Plane {
+    double nx, ny, c;  // inside, grown: nx·x + ny·y <= c (unit normal)
+  };
+  void add_plane(double nx, double ny, const Point& on, double band_units);
+  std::vector<Plane> planes_;
+  Rect box_;  // of the polygon, grown by the band (rounded outwards)
+};
+
 // True when no material of `cell` (its polygons `touched`) lies within any capsule of the
 // sections `selected` of `ls`: their clip can remove at most the band. False when a selected
 // section has no capsules (tilted and lathe sections). Exact up to the

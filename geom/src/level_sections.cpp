@@ -64,6 +64,8 @@ void SubtractEngine::build_level(int level, const SubtractShared& sh, SubtractWo
   ls.all = Rect{};
   ls.ix0 = ls.iy0 = 0;
   ls.ix1 = ls.iy1 = -1;
+  ls.anchors = &s_.ws_->level_anchors[static_cast<std::size_t>(level)];
+  ls.anchor = 0;
   // The material of this level before the batch (the cells' boxes and masks): tilted
   // sub-steps beside it are not built, and pieces whose sections miss it are marked in_air
   // (Sweep::tilted_pieces()).
@@ -315,6 +317,8 @@ void SubtractEngine::build_tilted(const SubtractShared& sh, const PlaneMaterial&
                                     i > 0 ? &ws.piece_cover[(i - 1) % 2] : nullptr,
                                     i + 1 < n ? &ws.piece_cover[i % 2] : nullptr, &material};
     sh.sweeps[p.sweep].build_piece(p, covers, ls.paths, ws.scratch);
+    if (i + 1 == n && ls.paths.size() == before + 1)  // before joins and border splits
+      keep_anchor(level, ls.paths.back(), sh.sweeps[p.sweep].shape().chord_tol_mm, ls);
     if (ls.paths.size() > before) id = std::max(id, sh.sweep_id[p.sweep]);
     if (ls.paths.size() - ls.box.size() >= kTiltedGroup) {
       join_tilted(ls.box.size(), id, ws, ls, stats);
@@ -343,7 +347,27 @@ void SubtractEngine::reset_level_last() const {
   if (kept.level_last_epoch != s_.removal_epoch() || kept.level_last.size() != levels) {
     kept.level_last.resize(levels);
     kept.level_last_set.assign(levels, 0);
+    kept.level_anchors.assign(levels, LevelAnchors{});
+    kept.cell_anchor.assign(s_.cells_.size(), 0);
     kept.level_last_epoch = s_.removal_epoch();
+  }
+}
+
+// The last piece of a level's tilted run, `poly` (convex, before joins and border splits),
+// becomes the level's newest anchor (LevelAnchors), a generation given to the cells that
+// this batch clips there (clip_cell()); a later run of the batch on the level replaces it.
+// Its band: reach_band_units() of the tool's chord tolerance.
+void SubtractEngine::keep_anchor(std::size_t level, const Path& poly, double chord_tol_mm, LevelSections& ls) const {
+  LevelAnchors& a = s_.ws_->level_anchors[level];
+  const std::uint64_t g = ls.anchor != 0 ? ls.anchor : a.last + 1;
+  const std::size_t slot = g % LevelAnchors::kSize;
+  if (a.piece[slot].set(poly, reach_band_units(chord_tol_mm))) {
+    a.gen[slot] = g;
+    a.last = g;
+    ls.anchor = g;
+  } else {
+    a.gen[slot] = 0;
+    ls.anchor = 0;
   }
 }
 

@@ -67,6 +67,7 @@ class SubtractEngine {
   void reset_cell_masks(bool tilted) const;
   [[nodiscard]] RegionRange tilted_regions(const SubtractShared& sh) const noexcept;
   [[nodiscard]] const TiltedPiece* level_prior(std::size_t level) const;
+  void keep_anchor(std::size_t level, const Path& poly, double chord_tol_mm, LevelSections& ls) const;
   static void join_tilted(std::size_t begin, MoveId id, SubtractWorkspace& ws, LevelSections& ls, SubtractStats& stats);
   static void add_chain_sections(int level, const SubtractShared& sh, LevelSections& ls);
   void add_lathe_sections(double zc, const SubtractShared& sh, LevelSections& ls) const;
@@ -87,8 +88,10 @@ class SubtractEngine {
                       SubtractStats& stats) const;
   void run_difference(const Cell& cell, int region, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
                       SubtractStats& stats) const;
-  bool clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
-                 SubtractStats& stats);
+  CellOutcome difference_cell(std::size_t ci, int region, const LevelSections& ls, SubtractShared& sh,
+                              SubtractWorkspace& ws, SubtractStats& stats);
+  CellOutcome clip_cell(int region, int level, const LevelSections& ls, SubtractShared& sh, SubtractWorkspace& ws,
+                        SubtractStats& stats);
 
   // The region's rectangle grown by 1 mm: what a clip of its cells needs of a long section.
   [[nodiscard]] Rect grown_region_rect(int region) const noexcept;

@@ -163,7 +163,7 @@ void SubtractEngine::clip_phase(SubtractShared& sh, SubtractWorkspace& ws, const
     if (item - pre < ws.jobs.size()) {
       const std::size_t k = ws.jobs[item - pre];
       const int l = sh.lb + static_cast<int>(k / nreg), region = static_cast<int>(k % nreg);
-      sh.outcome[k] = clip_cell(region, l, sh.levels[k / nreg], sh, ws, stats) ? 1 : 0;
+      sh.outcome[k] = clip_cell(region, l, sh.levels[k / nreg], sh, ws, stats);
       continue;
     }
     if (ahead != nullptr) {
@@ -193,7 +193,8 @@ void SubtractEngine::copy_runs(const SubtractShared& sh, const SubtractWorkspace
         if (src == l) continue;
         if (copy++ % static_cast<std::size_t>(count) != static_cast<std::size_t>(index)) continue;
         ++stats.cells_reused;
-        if (sh.outcome[static_cast<std::size_t>(src - lb) * nreg + static_cast<std::size_t>(region)] == 0) continue;
+        // (The cell keeps its anchor: this level's removed piece may differ from the source's.)
+        if (sh.outcome[static_cast<std::size_t>(src - lb) * nreg + static_cast<std::size_t>(region)] != kCellChanged) continue;
         const std::size_t ci = static_cast<std::size_t>(region) * levels + static_cast<std::size_t>(l);
         const Cell& from = s_.cells_[static_cast<std::size_t>(region) * levels + static_cast<std::size_t>(src)];
         Cell& to = s_.cells_[ci];

@@ -3,6 +3,7 @@
 // or geom::ParallelSubtractor (docs/architecture.md, "Kernel").
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -28,6 +29,26 @@ inline void cpu_relax() noexcept {
 #endif
 }
 
+// The last tilted sections that batches subtracted on one level (PriorPiece), a ring by
+// generation: entry g sits in piece[g % kSize] while gen[g % kSize] == g. A cell's
+// SubtractWorkspace::cell_anchor names the latest one its clips have taken.
+struct LevelAnchors {
+  static constexpr std::size_t kSize = 4;
+  std::array<PriorPiece, kSize> piece;
+  std::array<std::uint64_t, kSize> gen{};
+  std::uint64_t last = 0;  // the latest generation given out on the level
+  [[nodiscard]] const PriorPiece* find(std::uint64_t g) const noexcept {
+    return g != 0 && gen[g % kSize] == g ? &piece[g % kSize] : nullptr;
+  }
+};
+
+// What a clip of one cell did (SubtractShared::outcome).
+enum CellOutcome : std::uint8_t {
+  kCellKept = 0,      // nothing changed
+  kCellChanged = 1,   // the cell changed
+  kCellInAnchor = 2,  // left out: the sections lie inside a piece the cell has had removed
+};
+
 // The sections of one level for one batch, built by one thread and read by all.
 struct LevelSections {
   Paths paths;                        // convex sections, lathe regions; empty for a chain
@@ -43,6 +64,8 @@ struct LevelSections {
   // reach_begin = kNoReach (chain offsets, tilted and lathe sections).
   std::vector<ReachCapsule> reach;
   std::vector<std::uint32_t> reach_begin, reach_end;
+  const LevelAnchors* anchors = nullptr;  // the solid's removed pieces on this level
+  std::uint64_t anchor = 0;  // the generation of this batch's removed piece there, or 0 (none)
   [[nodiscard]] bool empty() const noexcept { return ix1 < ix0 || iy1 < iy0; }
 };
 
@@ -85,7 +108,7 @@ struct SubtractShared {
 
   // --- built by the threads ---
   std::vector<LevelSections> levels;    // per level the batch reaches, reused between batches
-  std::vector<std::uint8_t> outcome;    // per (level - lb, region): the clip changed the cell
+  std::vector<std::uint8_t> outcome;    // per (level - lb, region): CellOutcome
   // A chain offset by one radius (one per distinct (chain, radius) of the batch), and its
   // pieces cut to the regions its box reaches (rectangles grown by 1 mm), so that a clip
   // carries only the nearby edges. A piece is cut when a clip first needs it.
@@ -145,6 +168,12 @@ struct SubtractWorkspace {
   // own workspace (LbrSolid::ws_) holds them, whichever thread builds the level.
   std::vector<TiltedPiece> level_last;
   std::vector<std::uint8_t> level_last_set;
+  // Per level, the last tilted sections that batches removed (LevelAnchors); per cell
+  // (region * levels + level), the generation of the latest one that the cell's clips took
+  // (removed, or left out where it could remove the band at most), or 0. Forgotten with the
+  // removal epoch as level_last is; a cell's entry is written by the thread that clips it.
+  std::vector<LevelAnchors> level_anchors;
+  std::vector<std::uint64_t> cell_anchor;
   std::uint64_t level_last_epoch = 0;
   // Per cell (region * levels + level), its material as a raster, built when a tilted piece
   // first reaches the cell and rebuilt when it no longer clears one (LevelMaterial); sized on

@@ -132,6 +132,7 @@ struct SubtractStats {
   std::uint64_t sections_joined = 0;   // move sections written as part of a joined outline
   std::uint64_t outlines_star = 0;     // joined outlines of tight loops written as their outer chain only
   std::uint64_t cells_out_of_reach = 0;  // clips left out: no material within the sections' reach
+  std::uint64_t cells_in_anchor = 0;     // clips left out: the sections lie inside a piece already removed from the cell
   std::uint64_t clips_windowed = 0;      // clips fed the cell's contours reduced to the clip's window
   std::uint64_t window_fallbacks = 0;    // windowed clips done again with the whole contours
   std::uint64_t tilted_in_air = 0;       // tilted pieces not built: their section meets no material
@@ -142,7 +143,7 @@ struct SubtractStats {
     sections_trimmed += o.sections_trimmed; cells_reused += o.cells_reused;
     sections_in_air += o.sections_in_air; chain_offsets += o.chain_offsets;
     sections_joined += o.sections_joined; outlines_star += o.outlines_star;
-    cells_out_of_reach += o.cells_out_of_reach;
+    cells_out_of_reach += o.cells_out_of_reach; cells_in_anchor += o.cells_in_anchor;
     clips_windowed += o.clips_windowed; window_fallbacks += o.window_fallbacks;
     tilted_in_air += o.tilted_in_air; tilted_beside += o.tilted_beside;
     return *this;
