@@ -93,6 +93,10 @@ TEST(PriorPiece, RefusesClockwiseConcaveAndDegeneratePolygons) {
   EXPECT_TRUE(p.empty());
   EXPECT_FALSE(p.set(polygon({{0, 0}, {2, 0}, {1, 0.5}, {2, 1}, {0, 1}}), 202.0));  // a notch
   EXPECT_FALSE(p.set(polygon({{0, 0}, {1, 0}, {2, 0}}), 202.0));                    // no area
+  // A pentagram turns left at every vertex but goes round twice.
+  std::vector<std::pair<double, double>> star;
+  for (int k = 0; k < 5; ++k) star.emplace_back(std::cos(0.8 * test::kPi * k), std::sin(0.8 * test::kPi * k));
+  EXPECT_FALSE(p.set(polygon(star), 202.0));
   EXPECT_FALSE(p.set(polygon({{0, 0}, {1, 0}}), 202.0));
   EXPECT_FALSE(p.box_holds(geom::Rect{0, 0, 1, 1}));
   // Repeated vertices are edges without length: left out.

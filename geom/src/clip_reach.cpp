@@ -298,28 +298,30 @@ bool PriorPiece::set(const Path& poly, double band_units) {
   constexpr double kStep = std::numbers::pi / 3.0;  // bevels: at most 60 degrees between planes
   const double out = band_units * std::cos(kStep / 2.0);  // each plane's move: a corner reaches the band
   Rect box;
-  double turned = 0.0;
+  int windings = 0;  // the normals' turns through angle 0: once around for a convex polygon
   for (std::size_t i = 0; i < n; ++i) {
     double nx = 0.0, ny = 0.0;
     if (!normal(i, nx, ny)) continue;
     const Point& a = poly[i];
-    const double turn = std::atan2(px * ny - py * nx, px * nx + py * ny);  // at a; negative: a concave corner
-    if (turn < 0.0) {
+    const double cross = px * ny - py * nx, dot = px * nx + py * ny;  // the turn at a
+    if (cross < 0.0 || (cross == 0.0 && dot < 0.0)) {  // concave, or a spike
       planes_.clear();
       return false;
     }
-    turned += turn;
-    const int bevels = static_cast<int>(std::ceil(turn / kStep)) - 1;
-    const double from = std::atan2(py, px);
-    for (int k = 1; k <= bevels; ++k) {
-      const double t = from + turn * k / (bevels + 1);
-      add_plane(std::cos(t), std::sin(t), a, out);
+    if (py < 0.0 && ny >= 0.0) ++windings;  // a left turn below π from the lower half passes angle 0
+    if (dot < std::cos(kStep)) {  // more than 60 degrees: bevels between the two planes
+      const double turn = std::atan2(cross, dot), from = std::atan2(py, px);
+      const int bevels = static_cast<int>(std::ceil(turn / kStep)) - 1;
+      for (int k = 1; k <= bevels; ++k) {
+        const double t = from + turn * k / (bevels + 1);
+        add_plane(std::cos(t), std::sin(t), a, out);
+      }
     }
     add_plane(nx, ny, a, out);
     box.add(a);
     px = nx, py = ny;
   }
-  if (planes_.size() < 3 || std::abs(turned - 2.0 * std::numbers::pi) > 1e-6) {  // once around: simple and convex
+  if (planes_.size() < 3 || windings != 1) {  // once around: simple and convex
     planes_.clear();
     return false;
   }
